@@ -1,0 +1,43 @@
+"""coursekit: the Python companion to the state-space control course.
+
+Every public name of the submodules listed below is available directly as
+``coursekit.<name>``. Heavy libraries (SciPy submodules, sympy, matplotlib,
+ipywidgets) are imported inside the functions that use them, so that
+``import coursekit`` stays fast.
+
+Conventions (see the README): state feedback ``u = K x`` with closed loop
+``A + B K``; observer error dynamics ``A - L C``; polynomials as ascending
+coefficient arrays ``[a_0, ..., a_{n-1}]``; time series time-major.
+"""
+
+from importlib import import_module as _import_module
+
+__version__ = "0.1.0"
+
+# One module per job; each line lists the modules of one chapter of the notes.
+_MODULES = (
+    # chapter 1: representations
+    "systems", "simulation",
+    # chapter 2: controllability and open-loop control
+    "controllability",
+    # chapter 3: stability and state feedback
+    "placement",
+    # chapter 4: observability and observers
+    # course tools: figure style
+    "style",
+)
+
+__all__ = ["models"]
+for _name in _MODULES:
+    _module = _import_module(f".{_name}", __name__)
+    for _public in _module.__all__:
+        globals()[_public] = getattr(_module, _public)
+    __all__ += list(_module.__all__)
+del _name, _module, _public
+
+
+def __getattr__(name):
+    # `coursekit.models` is loaded on first use
+    if name == "models":
+        return _import_module(".models", __name__)
+    raise AttributeError(f"module 'coursekit' has no attribute {name!r}")

@@ -1,0 +1,211 @@
+"""Input checks shared by every public function.
+
+Each public function calls these on its first lines, passing the argument's
+name, so that a student who passes the wrong thing reads *which* argument is
+wrong, what was received and what was expected, e.g.::
+
+    ValueError: B has the wrong number of rows: received shape (3, 1),
+    expected 2 rows (one per state, since A is 2x2).
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+__all__ = [
+    "as_matrix",
+    "as_square",
+    "as_vector",
+    "as_scalar",
+    "as_time_grid",
+    "is_uniform",
+    "as_poles",
+    "check_function_output",
+]
+
+
+def _describe(value) -> str:
+    """A short description of what the user passed, for error messages."""
+    if isinstance(value, np.ndarray):
+        return f"an array of shape {value.shape}"
+    if isinstance(value, (list, tuple)):
+        return f"a {type(value).__name__} of length {len(value)}"
+    return f"{type(value).__name__} {value!r}"
+
+
+def _to_float_array(value, name: str) -> np.ndarray:
+    if value is None:
+        raise ValueError(f"{name} is missing: received None, expected a number or an array.")
+    try:
+        # sympy matrices, nested lists and numbers all pass through np.asarray
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise ValueError(
+            f"{name} must contain real numbers: received {_describe(value)} "
+            f"that cannot be converted to a float array ({err})."
+        ) from None
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(
+            f"{name} contains NaN or infinite entries: received {arr.tolist()!r}; "
+            "expected finite numbers (check the parameters it was built from)."
+        )
+    return arr
+
+
+def as_matrix(value, name: str, *, rows: int | None = None, cols: int | None = None,
+              rows_why: str = "", cols_why: str = "") -> np.ndarray:
+    """Return `value` as a finite 2-D float array, checking its shape.
+
+    A scalar becomes a 1x1 matrix. A 1-D array becomes a column when `cols`
+    is 1 and a row when `rows` is 1; any other 1-D input is ambiguous and
+    rejected. `rows_why` / `cols_why` explain where the expected size comes
+    from ("one per state, since A is 2x2").
+    """
+    arr = _to_float_array(value, name)
+    if arr.ndim == 0:
+        arr = arr.reshape(1, 1)
+    elif arr.ndim == 1:
+        if cols == 1 and rows != 1:
+            arr = arr.reshape(-1, 1)
+        elif rows == 1 or arr.size == 1:
+            arr = arr.reshape(1, -1)
+        else:
+            raise ValueError(
+                f"{name} must be a 2-D matrix: received a 1-D array of length {arr.size}; "
+                f"write it as a list of rows, e.g. [[...], [...]], or as a column [[a], [b]]."
+            )
+    elif arr.ndim != 2:
+        raise ValueError(f"{name} must be a 2-D matrix: received an array with {arr.ndim} dimensions.")
+    for axis, want, why, word in ((0, rows, rows_why, "rows"), (1, cols, cols_why, "columns")):
+        if want is not None and arr.shape[axis] != want:
+            reason = f" ({why})" if why else ""
+            raise ValueError(
+                f"{name} has the wrong number of {word}: received shape {arr.shape}, "
+                f"expected {want} {word}{reason}."
+            )
+    return arr
+
+
+def as_square(value, name: str, *, size: int | None = None) -> np.ndarray:
+    """Return `value` as a finite square float matrix (of `size` if given)."""
+    arr = as_matrix(value, name)
+    if arr.shape[0] != arr.shape[1]:
+        raise ValueError(
+            f"{name} must be square: received shape {arr.shape}, expected (n, n)."
+        )
+    if size is not None and arr.shape[0] != size:
+        raise ValueError(f"{name} has the wrong size: received shape {arr.shape}, expected ({size}, {size}).")
+    if arr.shape[0] == 0:
+        raise ValueError(f"{name} is empty: expected at least one state.")
+    return arr
+
+
+def as_vector(value, name: str, *, size: int | None = None, why: str = "") -> np.ndarray:
+    """Return `value` as a finite 1-D float array (of length `size` if given).
+
+    Row and column matrices (shape (1, k) or (k, 1)) are flattened.
+    """
+    arr = _to_float_array(value, name)
+    if arr.ndim == 2 and 1 in arr.shape:
+        arr = arr.ravel()
+    elif arr.ndim == 0:
+        arr = arr.reshape(1)
+    if arr.ndim != 1:
+        raise ValueError(f"{name} must be a vector: received an array of shape {arr.shape}.")
+    if size is not None and arr.size != size:
+        reason = f" ({why})" if why else ""
+        raise ValueError(
+            f"{name} has the wrong length: received {arr.size} entries, expected {size}{reason}."
+        )
+    return arr
+
+
+def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False) -> float:
+    """Return `value` as a finite float, optionally checking it is > 0 or whole."""
+    arr = _to_float_array(value, name)
+    if arr.size != 1:
+        raise ValueError(f"{name} must be a single number: received {_describe(value)}.")
+    x = float(arr.reshape(()))
+    if positive and not x > 0:
+        raise ValueError(f"{name} must be positive: received {x!r}, expected a number > 0.")
+    if integer and x != round(x):
+        raise ValueError(f"{name} must be a whole number: received {x!r}.")
+    return x
+
+
+def as_time_grid(t, name: str = "t", *, min_points: int = 2) -> np.ndarray:
+    """Return `t` as a finite, strictly increasing 1-D time grid."""
+    arr = as_vector(t, name)
+    if arr.size < min_points:
+        raise ValueError(
+            f"{name} has too few points: received {arr.size}, expected at least {min_points} "
+            "(e.g. np.linspace(0, 10, 1001))."
+        )
+    steps = np.diff(arr)
+    if np.any(steps <= 0):
+        k = int(np.argmax(steps <= 0))
+        raise ValueError(
+            f"{name} must be strictly increasing: {name}[{k + 1}] = {arr[k + 1]!r} does not come "
+            f"after {name}[{k}] = {arr[k]!r}; sort the grid or build it with np.linspace."
+        )
+    return arr
+
+
+def is_uniform(t: np.ndarray, rtol: float = 1e-9) -> bool:
+    """True when the grid `t` has (to rounding) a constant step."""
+    steps = np.diff(t)
+    return bool(np.all(np.abs(steps - steps[0]) <= rtol * max(abs(steps[0]), np.abs(t).max())))
+
+
+def as_poles(poles, name: str = "poles", *, count: int) -> np.ndarray:
+    """Return `poles` as a complex array of length `count`, closed under conjugation.
+
+    Complex poles must come with their conjugate, otherwise no real gain can
+    place them.
+    """
+    try:
+        arr = np.atleast_1d(np.asarray(poles, dtype=complex)).ravel()
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a list of numbers: received {_describe(poles)}.") from None
+    if not np.all(np.isfinite(arr)):
+        raise ValueError(f"{name} contains NaN or infinite entries: received {arr.tolist()!r}.")
+    if arr.size != count:
+        raise ValueError(
+            f"{name} has the wrong length: received {arr.size} poles, expected {count} "
+            "(one per state)."
+        )
+    scale = max(1.0, float(np.abs(arr).max()))
+    remaining = list(arr[np.abs(arr.imag) > 1e-12 * scale])
+    while remaining:
+        p = remaining.pop()
+        match = [i for i, q in enumerate(remaining) if abs(q - np.conj(p)) <= 1e-9 * scale]
+        if not match:
+            raise ValueError(
+                f"{name} has the complex pole {p} without its conjugate {np.conj(p)}; "
+                "complex poles must come in conjugate pairs for a real gain."
+            )
+        remaining.pop(match[0])
+    return arr
+
+
+def check_function_output(func: Callable, args: tuple, name: str, *, size: int, what: str) -> np.ndarray:
+    """Call a user function once and explain a wrong return value before integrating.
+
+    `what` says what the value means ("dx/dt, one entry per state").
+    """
+    try:
+        out = func(*args)
+    except Exception as err:  # the user's own bug: say where it happened
+        raise ValueError(
+            f"{name} raised {type(err).__name__} when called once as a check "
+            f"with arguments of shapes {[np.shape(a) for a in args]}: {err}"
+        ) from err
+    arr = np.asarray(out, dtype=float) if out is not None else None
+    if arr is None or arr.ndim > 1 and not (arr.ndim == 2 and 1 in arr.shape) or arr.size != size:
+        got = "None (did the function forget to return?)" if arr is None else f"shape {arr.shape}"
+        raise ValueError(
+            f"{name} returned {got}; expected {size} numbers ({what})."
+        )
+    return arr.ravel()

@@ -1,0 +1,231 @@
+"""Simulation of continuous- and discrete-time systems: `simulate`.
+
+Three paths, chosen from the system and the input:
+
+* continuous LTI with an array input (or none): exact. The input is taken as
+  linear between samples (as `scipy.signal.lsim` and python-control do) and
+  the solution formula (2.4) is evaluated over each step with one matrix
+  exponential of an augmented matrix, so the result has no integration error
+  and works for any `A`, diagonalizable or not;
+* discrete-time systems (1.18), (1.27): the difference equation is iterated;
+* everything else (nonlinear systems, inputs given as a function `u(t, x)`):
+  `scipy.integrate.solve_ivp` with the DOP853 method and tight tolerances
+  (rtol=1e-9, atol=1e-12 by default).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+
+from ._validation import as_matrix, as_time_grid, as_vector, check_function_output, is_uniform
+from .systems import NonlinearSystem, StateSpace
+
+__all__ = ["simulate", "SimulationResult", "lti_step_matrices"]
+
+
+@dataclass(repr=False)
+class SimulationResult:
+    """What `simulate` returns; every series is time-major.
+
+    Attributes
+    ----------
+    t : (N,) array      -- the time grid
+    x : (N, n) array    -- the state at each time
+    y : (N, p) array    -- the output at each time
+    u : (N, m) array    -- the input that was applied at each time
+    system : StateSpace or NonlinearSystem -- the simulated system
+    """
+
+    t: np.ndarray
+    x: np.ndarray
+    y: np.ndarray
+    u: np.ndarray
+    system: object
+
+    def __repr__(self) -> str:
+        name = getattr(self.system, "name", "") or type(self.system).__name__
+        return (f"SimulationResult of {name}: {self.t.size} samples from t={self.t[0]:g} "
+                f"to t={self.t[-1]:g}; x {self.x.shape}, y {self.y.shape}, u {self.u.shape}")
+
+    def plot(self, *, which: str = "xu", **kwargs):
+        """Plot the response (see `coursekit.plotting.plot_response`); returns the figure."""
+        from .plotting import plot_response
+        return plot_response(self, which=which, **kwargs)
+
+
+def simulate(sys, t, u=None, x0=None, *, rtol: float = 1e-9, atol: float = 1e-12,
+             method: str = "DOP853") -> SimulationResult:
+    """Simulate `sys` on the time grid `t`.
+
+    Parameters
+    ----------
+    sys : StateSpace or NonlinearSystem
+    t : (N,) array
+        Strictly increasing times. For a discrete-time system the grid must
+        step by ``sys.dt`` (e.g. ``np.arange(N) * dt``).
+    u : None, (N, m) array or callable, optional
+        None means zero input. An array gives the input at each time; in
+        continuous time it is taken as linear between samples. A callable
+        ``u(t, x)`` returns the m inputs at time t and state x: open-loop
+        signals ignore x, state feedback ``u = K x`` uses it (3.17).
+    x0 : (n,) array, optional
+        Initial state (default zero).
+    rtol, atol, method :
+        Tolerances and method of `scipy.integrate.solve_ivp`, used for
+        nonlinear systems and callable inputs only; the exact LTI path
+        ignores them. Pick ``method="LSODA"`` or ``"Radau"`` for a stiff system.
+
+    Returns
+    -------
+    SimulationResult with ``t, x, y, u`` (time-major) and ``.plot()``.
+    """
+    if not isinstance(sys, (StateSpace, NonlinearSystem)):
+        raise ValueError(
+            f"sys must be a StateSpace or NonlinearSystem: received {type(sys).__name__}; "
+            "build one with StateSpace(A, B, C, D) or NonlinearSystem(f, n, m)."
+        )
+    t = as_time_grid(t, "t", min_points=1 if sys.is_discrete else 2)
+    x0 = np.zeros(sys.n) if x0 is None else as_vector(
+        x0, "x0", size=sys.n, why=f"one per state of the {sys.n}-state system")
+    u_arr, u_fun = _input(sys, t, u, x0)
+    if sys.is_discrete:
+        _check_discrete_grid(t, sys.dt)
+        x, u_arr = _iterate(sys, t, x0, u_arr, u_fun)
+    elif isinstance(sys, StateSpace) and u_fun is None:
+        x = _lti_exact(sys, t, x0, u_arr)
+    else:
+        if isinstance(sys, NonlinearSystem):
+            sys.check(x0, u_fun(t[0], x0))
+        x = _integrate(sys, t, x0, u_fun, rtol=rtol, atol=atol, method=method)
+        u_arr = np.array([u_fun(tk, xk) for tk, xk in zip(t, x)]).reshape(t.size, sys.m)
+    return SimulationResult(t=t, x=x, y=_outputs(sys, x, u_arr), u=u_arr, system=sys)
+
+
+def _input(sys, t: np.ndarray, u, x0: np.ndarray):
+    """Return (u_arr, u_fun): the input as samples, or as a function u(t, x)."""
+    m = sys.m
+    if u is None:
+        return np.zeros((t.size, m)), (None if isinstance(sys, StateSpace) else lambda tk, xk: np.zeros(m))
+    if callable(u):
+        def u_fun(tk, xk, _u=u):
+            return np.atleast_1d(np.asarray(_u(tk, xk), dtype=float)).ravel()
+        check_function_output(u, (t[0], x0), "u", size=m,
+                              what=f"the {m} input(s) at time t and state x")
+        return None, u_fun
+    if m == 0:
+        raise ValueError("u was given, but the system has no input (m = 0); leave u=None.")
+    u_arr = _input_array(u, t.size, m)
+    if isinstance(sys, StateSpace) or sys.is_discrete:
+        return u_arr, None
+
+    def interpolated(tk, xk):
+        return np.array([np.interp(tk, t, u_arr[:, j]) for j in range(m)])
+    return u_arr, interpolated
+
+
+def _input_array(u, N: int, m: int) -> np.ndarray:
+    arr = np.asarray(u)
+    if arr.ndim == 1 and m == 1:
+        u = arr.reshape(-1, 1)
+    return as_matrix(u, "u", rows=N, cols=m, rows_why="one row per time in t",
+                     cols_why="one column per input")
+
+
+def _check_discrete_grid(t: np.ndarray, dt: float) -> None:
+    if t.size > 1 and not np.allclose(np.diff(t), dt, rtol=1e-9, atol=0):
+        raise ValueError(
+            f"t must step by the system's sampling period dt={dt:g} for a discrete-time "
+            f"system: received steps between {np.diff(t).min():g} and {np.diff(t).max():g}; "
+            f"use t = np.arange(N) * {dt:g}."
+        )
+
+
+def _iterate(sys, t, x0, u_arr, u_fun):
+    """Iterate x(k+1) = f(x(k), u(k)) (1.18) / (1.27)."""
+    N, n = t.size, sys.n
+    if isinstance(sys, StateSpace) and u_fun is None:
+        w = u_arr[:-1] @ sys.B.T
+        return _recurse(sys.A, w, x0), u_arr
+    if isinstance(sys, NonlinearSystem):
+        sys.check(x0, u_fun(t[0], x0) if u_fun else u_arr[0])
+    x = np.empty((N, n))
+    u_out = np.empty((N, sys.m))
+    x[0] = x0
+    for k in range(N):
+        u_out[k] = u_fun(t[k], x[k]) if u_fun else u_arr[k]
+        if k + 1 < N:
+            x[k + 1] = sys.f(x[k], u_out[k])
+    return x, u_out
+
+
+def lti_step_matrices(A: np.ndarray, B: np.ndarray, h: float):
+    """Exact one-step matrices for x' = A x + B u with u linear over a step h.
+
+    Returns ``(Ad, B0, B1)`` with ``x(k+1) = Ad x(k) + B0 u(k) + B1 u(k+1)``,
+    from the matrix exponential of the augmented matrix
+    ``[[A h, B h, 0], [0, 0, I], [0, 0, 0]]`` -- the integral in (2.4)
+    evaluated in closed form for a piecewise-linear input.
+    """
+    from scipy.linalg import expm
+    n, m = B.shape
+    M = np.zeros((n + 2 * m, n + 2 * m))
+    M[:n, :n] = A * h
+    M[:n, n:n + m] = B * h
+    M[n:n + m, n + m:] = np.eye(m)
+    E = expm(M)
+    Ad, G0, G1 = E[:n, :n], E[:n, n:n + m], E[:n, n + m:]
+    return Ad, G0 - G1, G1
+
+
+def _lti_exact(sys: StateSpace, t: np.ndarray, x0: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """Exact response of a continuous LTI system to a piecewise-linear input."""
+    if is_uniform(t):
+        Ad, B0, B1 = lti_step_matrices(sys.A, sys.B, t[1] - t[0])
+        w = u[:-1] @ B0.T + u[1:] @ B1.T
+        return _recurse(Ad, w, x0)
+    x = np.empty((t.size, sys.n))
+    x[0] = x0
+    cache = {}
+    for k, h in enumerate(np.diff(t)):
+        key = round(float(h), 12)
+        if key not in cache:
+            cache[key] = lti_step_matrices(sys.A, sys.B, h)
+        Ad, B0, B1 = cache[key]
+        x[k + 1] = Ad @ x[k] + B0 @ u[k] + B1 @ u[k + 1]
+    return x
+
+
+def _recurse(Ad: np.ndarray, w: np.ndarray, x0: np.ndarray) -> np.ndarray:
+    """Run x(k+1) = Ad x(k) + w(k) from x(0) = x0; `w` has one row per step."""
+    x = np.empty((w.shape[0] + 1, x0.size))
+    x[0] = x0
+    AdT = Ad.T
+    for k in range(w.shape[0]):
+        x[k + 1] = x[k] @ AdT + w[k]
+    return x
+
+
+def _integrate(sys, t, x0, u_fun: Callable, *, rtol, atol, method) -> np.ndarray:
+    """Integrate x' = f(x, u(t, x)) with solve_ivp, returning x on the grid t."""
+    from scipy.integrate import solve_ivp
+
+    def rhs(tk, xk):
+        return sys.f(xk, u_fun(tk, xk))
+
+    sol = solve_ivp(rhs, (t[0], t[-1]), x0, t_eval=t, method=method, rtol=rtol, atol=atol)
+    if not sol.success or sol.y.shape[1] != t.size:
+        raise RuntimeError(
+            f"the ODE solver stopped at t={sol.t[-1] if sol.t.size else t[0]:g}: {sol.message}. "
+            "The solution may blow up (check the model), or the system may be stiff: "
+            "try method='LSODA' or method='Radau'."
+        )
+    return sol.y.T
+
+
+def _outputs(sys, x: np.ndarray, u: np.ndarray) -> np.ndarray:
+    if isinstance(sys, StateSpace):
+        return x @ sys.C.T + u @ sys.D.T
+    return np.array([sys.h(xk, uk) for xk, uk in zip(x, u)]).reshape(x.shape[0], -1)

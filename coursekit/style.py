@@ -1,0 +1,64 @@
+"""Figure style for the course: default sizes, and `lecture_mode` for a projector.
+
+Every figure coursekit makes is created with `new_figure`, which reads the
+current matplotlib settings, so switching `lecture_mode` on before building
+a plot or an explorer makes it readable from the back of a lecture hall.
+"""
+
+from __future__ import annotations
+
+__all__ = ["lecture_mode", "is_lecture_mode", "new_figure", "LECTURE_STYLE"]
+
+#: matplotlib settings applied by ``lecture_mode(True)``.
+LECTURE_STYLE = {
+    "figure.figsize": (12.0, 6.5),
+    "figure.dpi": 100,
+    "font.size": 17,
+    "axes.titlesize": 20,
+    "axes.labelsize": 18,
+    "xtick.labelsize": 15,
+    "ytick.labelsize": 15,
+    "legend.fontsize": 15,
+    "lines.linewidth": 3.0,
+    "lines.markersize": 9,
+    "axes.linewidth": 1.5,
+    "grid.linewidth": 1.0,
+}
+
+_saved: dict | None = None
+
+
+def lecture_mode(on: bool = True) -> None:
+    """Switch large fonts, thick lines and big figures on (or back off).
+
+    Affects every figure created afterwards: notebook plots, coursekit's
+    plotting helpers and explorers built after the call. ``lecture_mode(False)``
+    restores the settings that were in force before it was switched on.
+    """
+    import matplotlib as mpl
+    global _saved
+    if on:
+        if _saved is None:
+            _saved = {key: mpl.rcParams[key] for key in LECTURE_STYLE}
+        mpl.rcParams.update(LECTURE_STYLE)
+    elif _saved is not None:
+        mpl.rcParams.update(_saved)
+        _saved = None
+
+
+def is_lecture_mode() -> bool:
+    """True while lecture mode is on."""
+    return _saved is not None
+
+
+def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplot_kw):
+    """A matplotlib Figure with a grid of axes, outside pyplot's global state.
+
+    Returns ``(fig, axes)`` like ``plt.subplots``. The figure is not shown
+    automatically; display it with ``IPython.display.display(fig)`` or return
+    it as the last expression of a notebook cell.
+    """
+    from matplotlib.figure import Figure
+    fig = Figure(figsize=figsize, layout="constrained")
+    axes = fig.subplots(nrows, ncols, squeeze=True, **subplot_kw)
+    return fig, axes

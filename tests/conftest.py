@@ -1,0 +1,17 @@
+"""Shared test settings: hypothesis profiles and small helpers."""
+
+import os
+
+import numpy as np
+from hypothesis import HealthCheck, settings
+
+settings.register_profile("default", deadline=None, max_examples=60,
+                          suppress_health_check=[HealthCheck.too_slow])
+settings.register_profile("ci", parent=settings.get_profile("default"), derandomize=True)
+settings.load_profile("ci" if os.environ.get("CI") else "default")
+
+
+def sorted_eig(values):
+    """Eigenvalues sorted by real then imaginary part, for comparisons."""
+    values = np.asarray(values, dtype=complex)
+    return values[np.lexsort((values.imag.round(8), values.real.round(8)))]

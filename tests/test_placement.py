@@ -1,0 +1,73 @@
+"""place: single input by the CCF method, several inputs by SciPy, with checks."""
+
+import control
+import numpy as np
+import pytest
+from hypothesis import given, strategies as st
+
+import coursekit as ck
+from conftest import sorted_eig
+
+
+def test_example_2_66_placed_at_minus_one_and_minus_two():
+    A, B = np.array([[0, 2], [1, -3]]), np.array([[1], [0]])
+    K = ck.place(A, B, [-1, -2])
+    np.testing.assert_allclose(K, [[0, -4]], atol=1e-12)
+    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A + B @ K)), [-2, -1], atol=1e-12)
+
+
+def test_details_show_each_step():
+    d = ck.place_details([[0, 2], [1, -3]], [[1], [0]], [-1, -2])
+    np.testing.assert_allclose(d.a, [-2, 3])      # s^2 + 3 s - 2
+    np.testing.assert_allclose(d.p, [2, 3])       # s^2 + 3 s + 2
+    np.testing.assert_allclose(d.K, d.K_ccf @ d.T)
+
+
+@given(st.integers(2, 8), st.integers(0, 10_000))
+def test_single_input_matches_python_control_with_flipped_sign(n, seed):
+    rng = np.random.default_rng(seed)
+    A, B = rng.normal(size=(n, n)), rng.normal(size=(n, 1))
+    if np.linalg.cond(ck.ctrb(A, B)) > 1e6:
+        return
+    poles = -np.linspace(1, 2.5, n)
+    K = ck.place(A, B, poles)
+    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A + B @ K)), sorted_eig(poles), atol=1e-5)
+    K_ref = -np.atleast_2d(control.acker(A, B, poles))
+    np.testing.assert_allclose(K, K_ref, rtol=1e-6, atol=1e-8 * np.abs(K_ref).max())
+
+
+def test_repeated_and_complex_poles_single_input():
+    A, B = np.zeros((3, 3)) + np.eye(3, k=1), np.array([[0], [0], [1.0]])
+    K = ck.place(A, B, [-2, -2, -2])
+    np.testing.assert_allclose(K, [[-8, -12, -6]], atol=1e-12)
+    K = ck.place(A, B, [-1 + 2j, -1 - 2j, -3])
+    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A + B @ K)), sorted_eig([-1 + 2j, -1 - 2j, -3]), atol=1e-9)
+
+
+def test_two_inputs_use_the_robust_method():
+    A = np.array([[0, 1, 0], [0, 0, 1], [1, 2, 3.0]])
+    B = np.array([[0, 1], [1, 0], [0, 1.0]])
+    K = ck.place(A, B, [-1, -2, -3])
+    assert K.shape == (2, 3)
+    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A + B @ K)), [-3, -2, -1], atol=1e-9)
+    K = ck.place(A, B, [-2, -2, -3])
+    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A + B @ K)), [-3, -2, -2], atol=1e-6)
+
+
+@pytest.mark.parametrize("poles, message", [
+    ([-1, -2], r"poles has the wrong length: received 2 poles, expected 3"),
+    ([-1 + 1j, -1 + 1j, -2], r"without its conjugate"),
+    ([-1, np.nan, -2], r"poles contains NaN"),
+])
+def test_bad_poles(poles, message):
+    with pytest.raises(ValueError, match=message):
+        ck.place(np.eye(3, k=1), [[0], [0], [1]], poles)
+
+
+def test_repeated_more_than_rank_b_and_uncontrollable():
+    A = np.array([[0, 1, 0], [0, 0, 1], [1, 2, 3.0]])
+    B = np.array([[0, 1], [1, 0], [0, 1.0]])
+    with pytest.raises(ValueError, match=r"at most rank\(B\) = 2 times"):
+        ck.place(A, B, [-2, -2, -2])
+    with pytest.raises(ck.NotControllableError, match=r"not controllable"):
+        ck.place([[-1, 0], [0, -2]], [[1], [0]], [-3, -4])
