@@ -6,7 +6,9 @@ Three paths, chosen from the system and the input:
   linear between samples (as `scipy.signal.lsim` and python-control do) and
   the solution formula (2.4) is evaluated over each step with one matrix
   exponential of an augmented matrix, so the result has no integration error
-  and works for any `A`, diagonalizable or not;
+  and works for any `A`, diagonalizable or not. On a uniform grid the
+  resulting recursion runs through a Schur form with `lfilter` (see
+  `_recurse`), with no Python loop over samples;
 * discrete-time systems (1.18), (1.27): the difference equation is iterated;
 * everything else (nonlinear systems, inputs given as a function `u(t, x)`):
   `scipy.integrate.solve_ivp` with the DOP853 method and tight tolerances
@@ -199,13 +201,28 @@ def _lti_exact(sys: StateSpace, t: np.ndarray, x0: np.ndarray, u: np.ndarray) ->
 
 
 def _recurse(Ad: np.ndarray, w: np.ndarray, x0: np.ndarray) -> np.ndarray:
-    """Run x(k+1) = Ad x(k) + w(k) from x(0) = x0; `w` has one row per step."""
-    x = np.empty((w.shape[0] + 1, x0.size))
-    x[0] = x0
-    AdT = Ad.T
-    for k in range(w.shape[0]):
-        x[k + 1] = x[k] @ AdT + w[k]
-    return x
+    """Run x(k+1) = Ad x(k) + w(k) from x(0) = x0; `w` has one row per step.
+
+    Fast and exact for any Ad, diagonalizable or not: with the complex Schur
+    form Ad = Z S Z^H (S upper triangular) the coordinates z = Z^H x obey
+    z_i(k+1) = S_ii z_i(k) + [v_i(k) + sum_{j>i} S_ij z_j(k)], v = Z^H w.
+    The last row depends on nothing else; solving the rows from the last to
+    the first, each is a first-order recursion run by `scipy.signal.lfilter`
+    over the whole time axis at once (no Python loop over samples).
+    """
+    from scipy.linalg import schur
+    from scipy.signal import lfilter
+    S, Z = schur(Ad, output="complex")
+    n = x0.size
+    z = np.empty((n, w.shape[0] + 1), dtype=complex)
+    z[:, 0] = Z.conj().T @ x0
+    z[:, 1:] = Z.conj().T @ w.T
+    for i in range(n - 1, -1, -1):
+        if i + 1 < n:
+            z[i, 1:] += S[i, i + 1:] @ z[i + 1:, :-1]
+        # y(0) = z_i(0), y(k+1) = S_ii y(k) + input(k)
+        z[i] = lfilter([1.0], [1.0, -S[i, i]], z[i])
+    return (Z @ z).real.T.copy()
 
 
 def _integrate(sys, t, x0, u_fun: Callable, *, rtol, atol, method) -> np.ndarray:
