@@ -146,3 +146,21 @@ def test_discrete_grid_must_step_by_dt():
 def test_not_a_system_is_rejected():
     with pytest.raises(ValueError, match=r"sys must be a StateSpace or NonlinearSystem"):
         ck.simulate([[0, 1], [0, 0]], np.linspace(0, 1, 3))
+
+
+def test_batch_matches_one_at_a_time_for_the_pendulum_under_feedback():
+    pend = ck.models.pendulum(d_theta=0.2)
+    K = np.array([[-20.0, -5.0]])
+    t = np.linspace(0, 3, 61)
+    x0s = np.array([[0.5, 0], [1.5, 0], [-2.5, 1.0]])
+    batch = ck.simulate_batch(pend, t, x0s, u=lambda tk, X: K @ X)
+    assert batch.shape == (61, 3, 2)
+    for j, x0 in enumerate(x0s):
+        single = ck.simulate(pend, t, lambda tk, x: K @ x, x0=x0)
+        np.testing.assert_allclose(batch[:, j], single.x, atol=1e-7)
+
+
+def test_batch_rejects_a_vector_field_that_cannot_take_a_batch():
+    scalar_only = ck.NonlinearSystem(lambda x, u: [float(x[1]), -float(x[0])], n=2)
+    with pytest.raises(ValueError, match=r"f cannot be evaluated on a batch"):
+        ck.simulate_batch(scalar_only, np.linspace(0, 1, 3), [[1, 0], [0, 1]])
