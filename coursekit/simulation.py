@@ -212,8 +212,7 @@ def _iterate(sys, t, x0, u_arr, u_fun):
     """Iterate x(k+1) = f(x(k), u(k)) (1.18) / (1.27)."""
     N, n = t.size, sys.n
     if isinstance(sys, StateSpace) and u_fun is None:
-        w = u_arr[:-1] @ sys.B.T
-        return _recurse(sys.A, w, x0), u_arr
+        return _recurse(sys.A, x0, [(sys.B, u_arr[:-1])]), u_arr
     if isinstance(sys, NonlinearSystem):
         sys.check(x0, u_fun(t[0], x0) if u_fun else u_arr[0])
     x = np.empty((N, n))
@@ -249,8 +248,7 @@ def _lti_exact(sys: StateSpace, t: np.ndarray, x0: np.ndarray, u: np.ndarray) ->
     """Exact response of a continuous LTI system to a piecewise-linear input."""
     if is_uniform(t):
         Ad, B0, B1 = lti_step_matrices(sys.A, sys.B, t[1] - t[0])
-        w = u[:-1] @ B0.T + u[1:] @ B1.T
-        return _recurse(Ad, w, x0)
+        return _recurse(Ad, x0, [(B0, u[:-1]), (B1, u[1:])])
     x = np.empty((t.size, sys.n))
     x[0] = x0
     cache = {}
@@ -263,9 +261,10 @@ def _lti_exact(sys: StateSpace, t: np.ndarray, x0: np.ndarray, u: np.ndarray) ->
     return x
 
 
-def _recurse(Ad: np.ndarray, w: np.ndarray, x0: np.ndarray) -> np.ndarray:
-    """Run x(k+1) = Ad x(k) + w(k) from x(0) = x0; `w` has one row per step.
+def _recurse(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
+    """Run x(k+1) = Ad x(k) + w(k) from x(0) = x0, with w(k) = sum of Bj uj(k).
 
+    `terms` is a list of pairs ``(Bj, uj)``, each `uj` with one row per step.
     Fast and exact for any Ad, diagonalizable or not: with the complex Schur
     form Ad = Z S Z^H (S upper triangular) the coordinates z = Z^H x obey
     z_i(k+1) = S_ii z_i(k) + [v_i(k) + sum_{j>i} S_ij z_j(k)], v = Z^H w.
@@ -277,12 +276,12 @@ def _recurse(Ad: np.ndarray, w: np.ndarray, x0: np.ndarray) -> np.ndarray:
     from scipy.signal import lfilter
     S, Z = schur(Ad, output="complex")
     n = x0.size
-    z = np.empty((n, w.shape[0] + 1), dtype=complex)
+    z = np.empty((n, terms[0][1].shape[0] + 1), dtype=complex)
     z[:, 0] = Z.conj().T @ x0
-    z[:, 1:] = Z.conj().T @ w.T
+    z[:, 1:] = sum((Z.conj().T @ Bj) @ uj.T for Bj, uj in terms)
     for i in range(n - 1, -1, -1):
         if i + 1 < n:
-            z[i, 1:] += S[i, i + 1:] @ z[i + 1:, :-1]
+            z[i, 1:] += (S[i, i + 1:] @ z[i + 1:])[:-1]
         # y(0) = z_i(0), y(k+1) = S_ii y(k) + input(k)
         z[i] = lfilter([1.0], [1.0, -S[i, i]], z[i])
     return (Z @ z).real.T.copy()
