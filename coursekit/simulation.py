@@ -209,10 +209,8 @@ def _check_discrete_grid(t: np.ndarray, dt: float) -> None:
 
 
 def _iterate(sys, t, x0, u_arr, u_fun):
-    """Iterate x(k+1) = f(x(k), u(k)) (1.18) / (1.27)."""
+    """Iterate x(k+1) = f(x(k), u(k)) (1.18) / (1.27), one step at a time, exactly as written."""
     N, n = t.size, sys.n
-    if isinstance(sys, StateSpace) and u_fun is None:
-        return _recurse(sys.A, x0, [(sys.B, u_arr[:-1])]), u_arr
     if isinstance(sys, NonlinearSystem):
         sys.check(x0, u_fun(t[0], x0) if u_fun else u_arr[0])
     x = np.empty((N, n))
@@ -284,7 +282,9 @@ def _recurse(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
             z[i, 1:] += (S[i, i + 1:] @ z[i + 1:])[:-1]
         # y(0) = z_i(0), y(k+1) = S_ii y(k) + input(k)
         z[i] = lfilter([1.0], [1.0, -S[i, i]], z[i])
-    return (Z @ z).real.T.copy()
+    x = (Z @ z).real.T.copy()
+    x[0] = x0  # exactly, not after a round trip through the Schur basis
+    return x
 
 
 def _integrate(sys, t, x0, u_fun: Callable, *, rtol, atol, method) -> np.ndarray:
