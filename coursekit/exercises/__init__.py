@@ -1,0 +1,22 @@
+"""Self-check exercises: the data of each exercise and a `check_*` that answers back.
+
+One module per chapter (`ch1` ... `ch4`); every name is also available here::
+
+    import coursekit.exercises as ex
+    ex.MSD                              # the exercise's numbers
+    ex.check_msd_state_space(A, B, C)   # prints "Correct: ..." or what is off
+
+A check accepts the answer as a list, a nested list, a NumPy array or a sympy
+Matrix, compares it with a tolerance suited to hand computation, prints
+specific feedback (which entry, shape or sign is off, with the equation of
+the notes to recheck), returns True when correct, and never raises on a wrong
+answer or prints the solution.
+"""
+
+from . import ch1, ch2, ch3, ch4
+from .ch1 import *  # noqa: F401,F403
+from .ch2 import *  # noqa: F401,F403
+from .ch3 import *  # noqa: F401,F403
+from .ch4 import *  # noqa: F401,F403
+
+__all__ = ["ch1", "ch2", "ch3", "ch4", *ch1.__all__, *ch2.__all__, *ch3.__all__, *ch4.__all__]

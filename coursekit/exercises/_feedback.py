@@ -1,0 +1,275 @@
+"""Compare a student's answer with the expected one and say what is off.
+
+Every ``check_*`` function of the chapter modules goes through these helpers,
+so the feedback reads the same everywhere:
+
+* `read_matrix` / `read_poles` / `read_decision` turn whatever the student
+  typed (list, nested list, NumPy array, sympy Matrix or number, a 1-D list
+  where a row or column is expected) into a float array, or into a message
+  that explains why it could not (a string, a symbol left in a sympy matrix,
+  ``None`` because the cell was not filled in);
+* `matrix_feedback` compares shapes, then looks for the classic mistakes
+  (transposed, whole sign flipped, a known wrong variant such as the MATLAB
+  sign of K) and finally names the entries that are off;
+* `Report` collects the messages and prints them once, starting with
+  "Correct" or "Not yet".
+
+Nothing here raises on a wrong answer and nothing prints the expected values.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+__all__ = [
+    "Report",
+    "close",
+    "read_matrix",
+    "read_poles",
+    "read_decision",
+    "matrix_feedback",
+    "poles_feedback",
+    "call_student_function",
+]
+
+#: relative tolerance for answers worked out by hand (0.333 for 1/3 is accepted)
+RTOL = 1e-3
+
+
+def close(answer: np.ndarray, expected: np.ndarray, rtol: float = RTOL) -> np.ndarray:
+    """Entry-wise "equal up to hand-computation rounding": |a - e| <= rtol max(1, |e|)."""
+    return np.abs(answer - expected) <= rtol * np.maximum(1.0, np.abs(expected))
+
+
+@dataclass
+class Report:
+    """The feedback of one check: a list of problems, printed in one go."""
+
+    name: str
+    problems: list[str] = field(default_factory=list)
+
+    def add(self, message: str) -> None:
+        self.problems.append(message)
+
+    @property
+    def ok(self) -> bool:
+        return not self.problems
+
+    def show(self, praise: str) -> bool:
+        """Print "Correct: praise" or the problems; return True when correct."""
+        if self.ok:
+            print(f"Correct: {praise}")
+        else:
+            print(f"Not yet ({self.name}):")
+            for message in self.problems:
+                print(f"  - {message}")
+        return self.ok
+
+
+def _is_sympy(value) -> bool:
+    # detect sympy objects without importing sympy
+    return type(value).__module__.split(".")[0] == "sympy"
+
+
+def _to_array(value, name: str, report: Report, *, dtype=float) -> np.ndarray | None:
+    """`value` as an array of numbers, or None with a message explaining why not."""
+    if value is None or value is Ellipsis:
+        report.add(f"{name} is empty (None): replace the placeholder with your answer.")
+        return None
+    if isinstance(value, (str, bytes)):
+        report.add(f"{name} is the text {value!r}: type numbers, e.g. [[1, 2], [3, 4]], not a string.")
+        return None
+    if callable(value) and not _is_sympy(value):
+        report.add(f"{name} is a function: call it and pass its result (numbers), not the function.")
+        return None
+    try:
+        arr = np.asarray(value, dtype=dtype)
+    except (TypeError, ValueError):
+        if _is_sympy(value) or any(_is_sympy(v) for v in np.ravel(np.asarray(value, dtype=object))):
+            report.add(f"{name} still contains symbols: substitute the numbers of the exercise "
+                       "(e.g. M.subs({m: 2, k: 8})) so that every entry is a number.")
+        else:
+            report.add(f"{name} could not be read as numbers: received {type(value).__name__}; "
+                       "write it as a list of rows, e.g. [[1, 2], [3, 4]], or a NumPy array.")
+        return None
+    if not np.all(np.isfinite(arr)):
+        report.add(f"{name} contains NaN or infinite entries: check the computation that built it.")
+        return None
+    return arr
+
+
+def read_matrix(value, name: str, shape: tuple[int, int], report: Report) -> np.ndarray | None:
+    """The student's matrix as a float array, keeping its own shape (for the shape feedback).
+
+    A 1-D list or a scalar is accepted where a row or a column is expected
+    (it is reshaped); anything else keeps its shape and `matrix_feedback`
+    explains a mismatch.
+    """
+    arr = _to_array(value, name, report)
+    if arr is None:
+        return None
+    rows, cols = shape
+    if arr.ndim == 0:
+        arr = arr.reshape(1, 1)
+    elif arr.ndim == 1 and (rows == 1 or cols == 1) and arr.size == rows * cols:
+        arr = arr.reshape(shape)
+    elif arr.ndim == 1:
+        arr = arr.reshape(1, -1)
+    elif arr.ndim > 2:
+        report.add(f"{name} has {arr.ndim} dimensions: a matrix is a list of rows (2 dimensions).")
+        return None
+    return arr
+
+
+def _describe_shape(shape: tuple[int, int]) -> str:
+    rows, cols = shape
+    if cols == 1 and rows > 1:
+        return f"a column ({rows} x 1)"
+    if rows == 1 and cols > 1:
+        return f"a row (1 x {cols})"
+    return f"{rows} x {cols}"
+
+
+def _entries(mask: np.ndarray) -> str:
+    """The 1-based positions where `mask` is True, as the notes index matrices."""
+    rows, cols = np.nonzero(mask)
+    if mask.shape[0] == 1 or mask.shape[1] == 1:
+        return ", ".join(str(i + 1) for i in np.flatnonzero(mask))
+    return ", ".join(f"({r + 1}, {c + 1})" for r, c in zip(rows, cols))
+
+
+def matrix_feedback(answer, expected, name: str, report: Report, *,
+                    known_mistakes: Sequence[tuple[Any, str]] = (),
+                    shape_hint: str = "", entry_hint: str = "") -> bool:
+    """Compare the student's `answer` with `expected` and add what is off to `report`.
+
+    `known_mistakes` pairs a typical wrong answer (an array of `expected`'s
+    shape) with the message to show when the student's answer equals it, e.g.
+    ``(-K, "your K has the MATLAB sign ...")``. `shape_hint` explains where the
+    shape comes from, `entry_hint` which equation to recheck for wrong entries.
+    Returns True when the answer is correct.
+    """
+    expected = np.asarray(expected, dtype=float)
+    arr = read_matrix(answer, name, expected.shape, report)
+    if arr is None:
+        return False
+    want = _describe_shape(expected.shape)
+    if arr.shape != expected.shape:
+        if arr.shape == expected.T.shape and np.all(close(arr.T, expected)):
+            report.add(f"{name} is transposed: it must be {want}, yours is "
+                       f"{_describe_shape(arr.shape)}. {shape_hint}".strip())
+        else:
+            report.add(f"{name} has the wrong shape: it must be {want}, yours is "
+                       f"{_describe_shape(arr.shape)}. {shape_hint}".strip())
+        return False
+    if np.all(close(arr, expected)):
+        return True
+    for mistake, message in known_mistakes:
+        mistake = np.asarray(mistake, dtype=float)
+        if mistake.shape == arr.shape and np.all(close(arr, mistake)):
+            report.add(message)
+            return False
+    if np.any(expected != 0) and np.all(close(-arr, expected)):
+        report.add(f"{name} has the opposite sign in every entry. {entry_hint}".strip())
+        return False
+    if arr.shape[0] == arr.shape[1] and np.all(close(arr.T, expected)):
+        report.add(f"{name} is transposed: rows and columns are swapped. {shape_hint}".strip())
+        return False
+    wrong = ~close(arr, expected)
+    flipped = wrong & close(-arr, expected)
+    other = wrong & ~flipped
+    if flipped.any():
+        report.add(f"{name}: the entries at {_entries(flipped)} have the wrong sign. {entry_hint}".strip())
+    if other.any():
+        report.add(f"{name}: the entries at {_entries(other)} are off (positions counted from 1). "
+                   f"{entry_hint}".strip())
+    return False
+
+
+def read_poles(value, name: str, count: int, report: Report) -> np.ndarray | None:
+    """A list of `count` (possibly complex) numbers, or None with a message."""
+    arr = _to_array(value, name, report, dtype=complex)
+    if arr is None:
+        return None
+    arr = arr.ravel()
+    if arr.size != count:
+        report.add(f"{name} must list {count} numbers (with repetitions), yours has {arr.size}.")
+        return None
+    return arr
+
+
+def _match(values: np.ndarray, targets: np.ndarray) -> np.ndarray:
+    """For each target, True when one of `values` (each used once) matches it."""
+    free = list(values)
+    found = np.zeros(targets.size, dtype=bool)
+    for i, t in enumerate(targets):
+        for j, v in enumerate(free):
+            if abs(v - t) <= RTOL * max(1.0, abs(t)):
+                found[i] = True
+                free.pop(j)
+                break
+    return found
+
+
+def poles_feedback(answer, expected, name: str, report: Report, *, hint: str = "") -> bool:
+    """Compare two lists of numbers as multisets (order does not matter)."""
+    expected = np.asarray(expected, dtype=complex).ravel()
+    arr = read_poles(answer, name, expected.size, report)
+    if arr is None:
+        return False
+    found = _match(arr, expected)
+    if found.all():
+        return True
+    report.add(f"{name}: {int((~found).sum())} of the {expected.size} values do not match. {hint}".strip())
+    return False
+
+
+_YES = {"yes", "y", "true", "controllable", "observable", "stable"}
+_NO = {"no", "n", "false", "not controllable", "uncontrollable", "not observable",
+       "unobservable", "not stable", "unstable"}
+
+
+def read_decision(value, name: str, report: Report) -> bool | None:
+    """A yes/no answer: True/False, 1/0, or the words yes/no, else None with a message."""
+    if isinstance(value, str):
+        word = value.strip().lower()
+        if word in _YES:
+            return True
+        if word in _NO:
+            return False
+    elif isinstance(value, (bool, np.bool_)) or (
+            isinstance(value, (int, np.integer)) and value in (0, 1)):
+        return bool(value)
+    elif _is_sympy(value) and str(value) in ("True", "False"):
+        return str(value) == "True"
+    report.add(f"{name} must be True or False (yes or no): received {value!r}.")
+    return None
+
+
+def call_student_function(func: Callable, args: tuple, name: str, size: int,
+                          report: Report) -> np.ndarray | None:
+    """Call the student's function once; its result as `size` floats, or None with a message."""
+    if not callable(func):
+        report.add(f"{name} must be a Python function (def {name}(...): ... return ...), "
+                   f"received {type(func).__name__}.")
+        return None
+    try:
+        out = func(*args)
+    except Exception as err:  # the student's own bug: say what happened
+        report.add(f"calling {name} raised {type(err).__name__}: {err}. "
+                   "Test it on one input first.")
+        return None
+    inner = Report(name)
+    arr = _to_array(out, f"the value returned by {name}", inner)
+    if arr is None:
+        report.add(inner.problems[0] if out is not None else
+                   f"{name} returned None: did it forget the return statement?")
+        return None
+    arr = arr.ravel()
+    if arr.size != size:
+        report.add(f"{name} returned {arr.size} numbers, expected {size}.")
+        return None
+    return arr

@@ -1,0 +1,129 @@
+"""Exercises of chapter 3 (stability and state feedback).
+
+1. `STABILITY`: decide which of four systems x' = A x are stable (section 3.2.2).
+2. `PLACE_CCF`: the gain K of a system in CCF from (3.44).
+3. `PLACE_GENERAL`: the gain K of a 2x2 system not in CCF, through z = T x (3.46)-(3.47).
+4. `LINEARIZE`: the linearization of the damped pendulum at the upright equilibrium (3.67)-(3.70).
+
+The course's convention is u = K x with closed loop A + B K (3.17)-(3.21).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..placement import place
+from ._feedback import Report, matrix_feedback, read_decision
+
+__all__ = [
+    "STABILITY", "check_stability",
+    "PLACE_CCF", "check_gain_ccf",
+    "PLACE_GENERAL", "check_gain_general",
+    "LINEARIZE", "check_pendulum_linearization",
+]
+
+#: four continuous-time systems x' = A x; which are (asymptotically) stable?
+STABILITY = (
+    ((-1.0, 2.0), (-2.0, -1.0)),
+    ((1.0, 2.0), (3.0, -4.0)),
+    ((0.0, 1.0), (-4.0, 0.0)),
+    ((-2.0, 5.0, 0.0), (0.0, -1.0, 7.0), (0.0, 0.0, -0.5)),
+)
+
+#: x' = A x + B u in CCF (last-row form (2.16)) and the wanted closed-loop poles.
+PLACE_CCF = {"A": ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (4.0, -1.0, 2.0)),
+             "B": ((0.0,), (0.0,), (1.0,)), "poles": (-1.0, -2.0, -4.0)}
+
+#: a 2x2 system that is not in CCF and the wanted closed-loop poles.
+PLACE_GENERAL = {"A": ((1.0, 2.0), (3.0, 0.0)), "B": ((0.0,), (1.0,)), "poles": (-2.0, -3.0)}
+
+#: damped pendulum (1.8), linearized at the upright equilibrium x* = [pi, 0], u* = 0.
+LINEARIZE = {"m": 0.5, "l": 0.8, "g": 9.81, "d_theta": 0.3, "x_eq": (np.pi, 0.0)}
+
+
+def check_stability(answers) -> bool:
+    """Check a list of four True/False: is x' = A x stable, for each A of `STABILITY`?"""
+    report = Report("stability")
+    truth = [bool(np.all(np.linalg.eigvals(np.array(A)).real < 0)) for A in STABILITY]
+    if isinstance(answers, (str, bytes)) or not hasattr(answers, "__len__"):
+        report.add(f"answers must be a list of {len(truth)} True/False, one per matrix: "
+                   f"received {answers!r}.")
+        return report.show("")
+    if len(answers) != len(truth):
+        report.add(f"answers must have {len(truth)} entries, one per matrix: yours has {len(answers)}.")
+        return report.show("")
+    for i, (answer, right) in enumerate(zip(answers, truth), start=1):
+        decision = read_decision(answer, f"answer {i}", report)
+        if decision is None or decision == right:
+            continue
+        A = np.array(STABILITY[i - 1])
+        if np.allclose(np.linalg.eigvals(A).real.max(), 0, atol=1e-9):
+            hint = ("an eigenvalue with real part 0 (on the imaginary axis) is not strictly "
+                    "negative: the state oscillates or stays, it does not go to 0.")
+        elif np.trace(A) < 0:
+            hint = ("a negative trace (sum of the eigenvalues) does not make every eigenvalue "
+                    "negative: compute them.")
+        else:
+            hint = "compute the eigenvalues: for a triangular matrix they are the diagonal entries."
+        report.add(f"matrix {i} is decided wrongly: stable means every eigenvalue of A has a "
+                   f"strictly negative real part (section 3.2.2); {hint}")
+    return report.show("each decision follows from the real parts of the eigenvalues (3.2.2).")
+
+
+def _gain_feedback(K, A: np.ndarray, B: np.ndarray, poles, report: Report, *, hint: str) -> bool:
+    """Compare a state-feedback gain with the course's K (u = K x), explaining the usual slips."""
+    K_ok = place(A, B, poles)
+    ok = matrix_feedback(K, K_ok, "K", report, known_mistakes=[
+        (-K_ok, "your K has the MATLAB sign: the course uses u = K x with closed loop A + B K (3.17), "
+                "so K is minus MATLAB's and SciPy's place()."),
+    ], shape_hint="K is m x n (3.19): one row per input, one column per state.", entry_hint=hint)
+    if not ok and len(report.problems) == 1 and "off" in report.problems[0]:
+        try:
+            Kst = np.asarray(K, dtype=float).reshape(K_ok.shape)
+            eig = np.sort_complex(np.linalg.eigvals(A + B @ Kst))
+            report.add("with your K the closed loop A + B K has the eigenvalues "
+                       + ", ".join(f"{e.real:.3g}" + (f"{e.imag:+.3g}j" if abs(e.imag) > 1e-9 else "")
+                                   for e in eig) + ".")
+        except (TypeError, ValueError):
+            pass
+    return ok
+
+
+def check_gain_ccf(K) -> bool:
+    """Check the gain K (u = K x) placing the poles of `PLACE_CCF`, from (3.42)-(3.44)."""
+    report = Report("pole placement in CCF")
+    A, B = np.array(PLACE_CCF["A"]), np.array(PLACE_CCF["B"])
+    _gain_feedback(K, A, B, PLACE_CCF["poles"], report,
+                   hint="Read a0, a1, a2 from the last row of A (it is -[a0 a1 a2]), expand "
+                        "p(s) = (s - p1)(s - p2)(s - p3) and use k_i = a_(i-1) - p_(i-1) (3.44).")
+    return report.show("eig(A + B K) are the wanted poles (3.44).")
+
+
+def check_gain_general(K) -> bool:
+    """Check the gain K (u = K x) placing the poles of `PLACE_GENERAL` via the CCF (3.46)-(3.47)."""
+    report = Report("pole placement, general case")
+    A, B = np.array(PLACE_GENERAL["A"]), np.array(PLACE_GENERAL["B"])
+    _gain_feedback(K, A, B, PLACE_GENERAL["poles"], report,
+                   hint="Find T (2.65), the CCF's a~ from T A T^-1, K~ from (3.46), then "
+                        "K = K~ T (3.47): the gain acts on x, not on z.")
+    return report.show("eig(A + B K) are the wanted poles, K = K~ T (3.47).")
+
+
+def check_pendulum_linearization(A, B) -> bool:
+    """Check (A, B) of the pendulum `LINEARIZE` linearized at theta = pi, theta' = 0 (3.67)."""
+    report = Report("linearized pendulum")
+    m, l, g, d = (LINEARIZE[k] for k in ("m", "l", "g", "d_theta"))
+    # Jacobians of f(x, u) = [x2, -(g/l) sin x1 - (d/m) x2 + u / (m l^2)] at x1 = pi (3.69)
+    A_ok = np.array([[0.0, 1.0], [g / l, -d / m]])
+    B_ok = np.array([[0.0], [1.0 / (m * l**2)]])
+    matrix_feedback(A, A_ok, "A", report, known_mistakes=[
+        ([[0, 1], [-g / l, -d / m]], "A: that is the linearization at the hanging equilibrium "
+                                     "theta = 0; at theta = pi, cos(theta) = -1 (3.69)-(3.70)."),
+        ([[0, 1], [g / l, 0]], "A: the damping term -(d_theta/m) theta' of (1.8) is missing."),
+        ([[0, 1], [g / l, -d / (m * l**2)]], "A: after dividing (1.8) by m l^2 the damping "
+                                             "coefficient is d_theta / m."),
+    ], entry_hint="A is the Jacobian df/dx (3.65) evaluated at x* = [pi, 0].")
+    matrix_feedback(B, B_ok, "B", report, known_mistakes=[
+        ([[0], [1]], "B: the torque enters theta'' divided by m l^2 (1.8)."),
+    ], shape_hint="B must be a column (n x 1): df/du.")
+    return report.show("A and B are the Jacobians at the upright equilibrium (3.67).")
