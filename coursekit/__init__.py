@@ -21,7 +21,7 @@ _MODULES = (
     # chapter 2: controllability and open-loop control
     "controllability",
     # chapter 3: stability and state feedback
-    "placement",
+    "placement", "stability", "equilibria", "linearization", "controllers",
     # chapter 4: observability and observers
     # course tools: figure style
     "style",

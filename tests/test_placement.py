@@ -71,3 +71,71 @@ def test_repeated_more_than_rank_b_and_uncontrollable():
         ck.place(A, B, [-2, -2, -2])
     with pytest.raises(ck.NotControllableError, match=r"not controllable"):
         ck.place([[-1, 0], [0, -2]], [[1], [0]], [-3, -4])
+
+
+def _random_pair(n, m, seed, max_cond):
+    """A random (A, B), or None when Wc is too ill-conditioned to be a fair test."""
+    rng = np.random.default_rng(seed)
+    A, B = rng.normal(size=(n, n)), rng.normal(size=(n, m))
+    return None if np.linalg.cond(ck.ctrb(A, B)) > max_cond else (A, B)
+
+
+def _high_precision_gain(A, B, poles, digits=40):
+    """Independent oracle: Ackermann's formula K = -e_n^T Wc^-1 p(A) in 40-digit arithmetic."""
+    import mpmath as mp
+    with mp.workdps(digits):
+        n = A.shape[0]
+        Am, col = mp.matrix(A.tolist()), mp.matrix(B.tolist())
+        W = mp.matrix(n, n)
+        for j in range(n):
+            for i in range(n):
+                W[i, j] = col[i]
+            col = Am * col
+        e_n = mp.matrix(n, 1)
+        e_n[n - 1] = 1
+        T1 = mp.lu_solve(W.T, e_n).T
+        P, power = mp.zeros(n, n), mp.eye(n)
+        for c in np.poly(poles).real[::-1]:       # p(A) = sum p_i A^i, exact for these poles
+            P += mp.mpf(float(c)) * power
+            power = power * Am
+        K = -(T1 * P)
+        return np.array([[float(K[0, j]) for j in range(n)]])
+
+
+@given(st.integers(2, 10), st.integers(0, 10_000))
+def test_single_input_up_to_n_10_agrees_with_a_high_precision_oracle_to_1e_6(n, seed):
+    # the issue's accuracy requirement: random systems, n <= 10, well-separated poles
+    pair = _random_pair(n, 1, seed, max_cond=1e8)
+    if pair is None:
+        return
+    A, B = pair
+    poles = -np.arange(1, n + 1) * 0.5
+    K = ck.place(A, B, poles)
+    K_ref = _high_precision_gain(A, B, poles)
+    np.testing.assert_allclose(K, K_ref, rtol=1e-6, atol=1e-6 * np.abs(K_ref).max())
+
+
+@given(st.integers(2, 5), st.integers(0, 10_000), st.floats(-4, -0.5))
+def test_repeated_pole_single_input(n, seed, pole):
+    pair = _random_pair(n, 1, seed, max_cond=1e5)
+    if pair is None:
+        return
+    A, B = pair
+    K = ck.place(A, B, [pole] * n)
+    # a pole of multiplicity n is sensitive (error ~ eps^(1/n)): check the polynomial instead
+    np.testing.assert_allclose(ck.charpoly(A + B @ K), np.poly([pole] * n)[::-1][:-1],
+                               rtol=1e-6, atol=1e-6 * abs(pole) ** n)
+
+
+@given(st.integers(2, 5), st.integers(2, 3), st.integers(0, 10_000))
+def test_mimo_places_the_poles_and_matches_scipy_with_flipped_sign(n, m, seed):
+    from scipy.signal import place_poles
+    pair = _random_pair(n, m, seed, max_cond=1e6)
+    if pair is None or np.linalg.matrix_rank(pair[1]) < m:
+        return
+    A, B = pair
+    poles = np.array([-1, -1.5 + 1j, -1.5 - 1j, -2, -3][:n] if n != 2 else [-1, -2])
+    K = ck.place(A, B, poles)
+    assert K.shape == (m, n)
+    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A + B @ K)), sorted_eig(poles), atol=1e-6)
+    np.testing.assert_allclose(K, -place_poles(A, B, poles).gain_matrix, atol=1e-9)

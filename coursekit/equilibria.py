@@ -1,0 +1,161 @@
+"""Equilibrium points of nonlinear systems, with and without input (section 3.4.1).
+
+An equilibrium x* with its input u* solves f(x*, u*) = 0 in continuous time
+(3.49), (3.55) and x* = f(x*, u*) in discrete time (3.53).
+
+* `find_equilibria(f, u_eq, guesses)`: numerically, with `scipy.optimize.root`
+  started from several points; the solutions are deduplicated;
+* `equilibrium_input(f, x_eq)`: the input u* that holds a chosen x* (3.56)-(3.59);
+* `symbolic_equilibria(f, unknowns)`: all solutions with `sympy.solve`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validation import as_matrix, as_scalar, as_vector
+from .systems import NonlinearSystem, StateSpace
+
+__all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
+
+
+def _field(f, n=None, dt=None):
+    """Return (g(x, u), n, m or None, dt) for a system or a bare function."""
+    if isinstance(f, (NonlinearSystem, StateSpace)):
+        return f.f, f.n, f.m, f.dt
+    if not callable(f):
+        raise ValueError(
+            f"f must be a NonlinearSystem or a function f(x, u) returning dx/dt: received "
+            f"{type(f).__name__}."
+        )
+    return (lambda x, u: np.asarray(f(x, u), dtype=float)), n, None, dt
+
+
+def _residual(g, dt):
+    # (3.49): f(x*, u*) = 0;  (3.53): f(x*, u*) - x* = 0 in discrete time
+    if dt is None:
+        return lambda x, u: np.ravel(g(x, u))
+    return lambda x, u: np.ravel(g(x, u)) - x
+
+
+def find_equilibria(f, u_eq=None, guesses=None, *, n=None, dt=None, bounds=(-5.0, 5.0),
+                    count: int = 30, seed: int = 0, tol: float = 1e-9):
+    """Equilibria x* of f for the fixed input u* (3.49), (3.53), (3.55).
+
+    Parameters
+    ----------
+    f : NonlinearSystem or callable f(x, u)
+    u_eq : (m,) array, optional
+        The constant input; zero (or no input) by default.
+    guesses : (k, n) array, optional
+        Starting points for the solver. Default: `count` random points drawn
+        uniformly in the box `bounds` (seeded by `seed`) -- a solver only finds
+        the equilibria near its starting points, so give guesses that cover
+        the region you care about.
+    n : int
+        Number of states; needed only when f is a bare function and no
+        guesses are given.
+    dt : float, optional
+        Sampling period for a bare discrete-time function (x* = f(x*, u*)).
+
+    Returns
+    -------
+    (k, n) array of distinct equilibria (rows), sorted by their entries.
+    Points closer than ``1e-6 * max(1, |x|)`` count as the same equilibrium.
+    """
+    g, n_sys, m, sys_dt = _field(f, n, dt)
+    dt = sys_dt if dt is None else as_scalar(dt, "dt", positive=True)
+    u = _input(u_eq, m)
+    X0 = _guesses(guesses, n_sys if n_sys is not None else n, bounds, count, seed)
+    residual = _residual(g, dt)
+    from scipy.optimize import root
+    found = []
+    for x0 in X0:
+        sol = root(lambda x: residual(x, u), x0, method="hybr", tol=1e-12)
+        if np.abs(residual(sol.x, u)).max() <= tol * max(1.0, np.abs(sol.x).max()):
+            found.append(sol.x)
+    return _unique(found, X0.shape[1])
+
+
+def _input(u_eq, m):
+    if u_eq is None:
+        return np.zeros(m or 0)
+    return as_vector(u_eq, "u_eq", size=m, why="one per input of the system") if m is not None \
+        else as_vector(u_eq, "u_eq")
+
+
+def _guesses(guesses, n, bounds, count, seed) -> np.ndarray:
+    if guesses is not None:
+        return as_matrix(guesses, "guesses", cols=n, cols_why="one column per state",
+                         rows=1 if np.ndim(guesses) == 1 else None)
+    if n is None:
+        raise ValueError("n is missing: with a bare function f(x, u) and no guesses, pass n= (the "
+                         "number of states) so that starting points can be drawn.")
+    lo, hi = (as_scalar(b, "bounds") for b in bounds)
+    if not hi > lo:
+        raise ValueError(f"bounds must be (low, high) with low < high: received {bounds!r}.")
+    rng = np.random.default_rng(seed)
+    return rng.uniform(lo, hi, size=(int(count), int(n)))
+
+
+def _unique(points, n: int) -> np.ndarray:
+    distinct: list[np.ndarray] = []
+    for p in points:
+        if not any(np.abs(p - q).max() <= 1e-6 * max(1.0, np.abs(q).max()) for q in distinct):
+            distinct.append(p)
+    if not distinct:
+        return np.zeros((0, n))
+    out = np.array(distinct)
+    # clean tiny round-off (e.g. -1e-17 -> 0) so results print and sort neatly
+    out[np.abs(out) < 1e-12] = 0.0
+    return out[np.lexsort(out.T[::-1])]
+
+
+def equilibrium_input(f, x_eq, *, m=None, u_guess=None, tol: float = 1e-9) -> np.ndarray:
+    """The input u* that makes x* an equilibrium: solves f(x*, u*) = 0 for u* (3.56)-(3.59).
+
+    Uses least squares (`scipy.optimize.least_squares`) from `u_guess`
+    (default zero) and raises ValueError when no input achieves f(x*, u*) = 0,
+    i.e. when x* cannot be held by any constant input (for the pendulum
+    (3.55): any x* with x2* != 0). `m` is needed only for a bare function.
+    """
+    g, n, m_sys, dt = _field(f)
+    m = m_sys if m_sys is not None else (None if m is None else int(as_scalar(m, "m", integer=True)))
+    if m is None or m < 1:
+        raise ValueError("m must be the number of inputs (>= 1): pass m= for a bare function f(x, u).")
+    x = as_vector(x_eq, "x_eq", size=n)
+    u0 = np.zeros(m) if u_guess is None else as_vector(u_guess, "u_guess", size=m)
+    residual = _residual(g, dt)
+    from scipy.optimize import least_squares
+    sol = least_squares(lambda u: residual(x, u), u0, xtol=1e-14, ftol=1e-14, gtol=1e-14)
+    r = residual(x, sol.x)
+    if np.abs(r).max() > tol * max(1.0, np.abs(x).max(), np.abs(sol.x).max()):
+        raise ValueError(
+            f"x_eq = {x.tolist()} is not an equilibrium for any constant input: the smallest "
+            f"residual f(x*, u*) found is {np.array2string(r, precision=3)}. Pick x_eq so "
+            "that the rows of f without input can vanish (e.g. zero velocities)."
+        )
+    return sol.x
+
+
+def symbolic_equilibria(f, unknowns, *, discrete: bool = False):
+    """All solutions of f = 0 (or x = f(x) in discrete time, with `discrete=True`) by sympy.
+
+    `f` is a list of sympy expressions in the state (and input) symbols;
+    `unknowns` lists the symbols to solve for -- the states for a system
+    without input (3.52), or e.g. ``[x2, u]`` to find the input that holds a
+    chosen angle (3.56). Returns a list of dicts symbol -> value. With
+    `discrete=True` the first ``len(f)`` unknowns must be the states.
+    Periodic solutions are listed once (sympy returns e.g. 0 and pi for
+    sin(x) = 0, not every multiple of pi). Declare state symbols with
+    ``real=True``, not ``positive=True``: a positivity assumption silently
+    removes the solutions at 0.
+    """
+    import sympy as sp
+    F = list(sp.Matrix(f))
+    X = list(unknowns)
+    if not X or not all(isinstance(v, sp.Symbol) for v in X):
+        raise ValueError(f"unknowns must be a non-empty list of sympy symbols: received {unknowns!r}.")
+    if discrete:
+        F = [fi - xi for fi, xi in zip(F, X)]
+    return sp.solve(F, X, dict=True)

@@ -1,0 +1,130 @@
+"""Stability of linear time-invariant systems (section 3.2) and pole plots.
+
+* `is_stable(A, dt=None)`: the main result of section 3.2.2 -- x' = A x is
+  stable exactly when every eigenvalue of A has a negative real part; for
+  x(t+1) = A x(t) every eigenvalue must lie strictly inside the unit circle;
+* `plot_poles(...)`: the eigenvalues in the complex plane with the stable
+  region shaded (left half plane, or unit disc in discrete time).
+
+Eigenvalues of A are the poles of the system: they are the roots of
+det(sI - A), the denominator of (3.13).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ._validation import as_scalar, as_square
+from .systems import StateSpace
+
+__all__ = ["is_stable", "stability_margin", "plot_poles"]
+
+
+def _matrix_and_dt(A, dt):
+    """Accept a StateSpace (its own dt unless dt is given) or a square matrix."""
+    if isinstance(A, StateSpace):
+        return A.A, A.dt if dt is None else as_scalar(dt, "dt", positive=True)
+    return as_square(A, "A"), None if dt is None else as_scalar(dt, "dt", positive=True)
+
+
+def stability_margin(A, dt=None) -> float:
+    """How far the slowest pole is inside the stable region (negative = unstable).
+
+    Continuous time: ``-max Re(lambda)``; discrete time: ``1 - max |lambda|``.
+    """
+    A, dt = _matrix_and_dt(A, dt)
+    lam = np.linalg.eigvals(A)
+    if dt is None:
+        return float(-lam.real.max())
+    return float(1.0 - np.abs(lam).max())
+
+
+def is_stable(A, dt=None) -> bool:
+    """True when x' = A x (or x(t+1) = A x(t) if `dt` is set) is asymptotically stable.
+
+    Implements the main result of section 3.2.2: every eigenvalue lambda of
+    A, i.e. every root of det(lambda I - A) = 0, must have Re(lambda) < 0.
+    In discrete time (`dt` = sampling period) the condition is |lambda| < 1.
+    `A` may also be a `StateSpace`, whose `dt` is then used.
+
+    The test is strict: a pole exactly on the boundary (e.g. the double
+    integrator, or a pure oscillator) is *not* stable.
+    """
+    A, dt = _matrix_and_dt(A, dt)
+    lam = np.linalg.eigvals(A)
+    if dt is None:
+        return bool(np.all(lam.real < 0))
+    return bool(np.all(np.abs(lam) < 1))
+
+
+def _as_pole_sets(poles) -> dict:
+    """A dict label -> complex array, from an array or a dict of arrays."""
+    if isinstance(poles, dict):
+        items = poles.items()
+    else:
+        items = [("poles", poles)]
+    out = {}
+    for label, values in items:
+        try:
+            arr = np.atleast_1d(np.asarray(values, dtype=complex)).ravel()
+        except (TypeError, ValueError):
+            raise ValueError(
+                f"poles[{label!r}] must be a list of numbers: received {type(values).__name__}."
+            ) from None
+        if not np.all(np.isfinite(arr)):
+            raise ValueError(f"poles[{label!r}] contains NaN or infinite entries: {arr.tolist()!r}.")
+        out[str(label)] = arr
+    if not out:
+        raise ValueError("poles is empty: pass an array of poles or a dict label -> poles.")
+    return out
+
+
+def plot_poles(poles, *, dt=None, ax=None, title: str | None = None):
+    """Plot poles in the complex plane with the stable region shaded.
+
+    Parameters
+    ----------
+    poles : array or dict
+        The poles (e.g. ``np.linalg.eigvals(A + B @ K)``), or a dict
+        ``{"open loop": p1, "closed loop": p2}`` to compare several sets.
+    dt : float, optional
+        None (continuous time): the left half plane is shaded. A sampling
+        period: the unit disc is shaded.
+    ax : matplotlib Axes, optional
+        Draw into this axes; by default a new figure is made with
+        `coursekit.style.new_figure`.
+    title : str, optional
+
+    Returns ``(fig, ax)``.
+    """
+    sets = _as_pole_sets(poles)
+    dt = None if dt is None else as_scalar(dt, "dt", positive=True)
+    if ax is None:
+        from .style import new_figure
+        fig, ax = new_figure()
+    else:
+        fig = ax.figure
+    everything = np.concatenate(list(sets.values()))
+    reach = 1.25 * max(1.0, float(np.abs(everything.real).max(initial=0)),
+                       float(np.abs(everything.imag).max(initial=0)))
+    if dt is None:
+        ax.axvspan(-reach, 0, color="tab:green", alpha=0.12, label="stable region (Re < 0)")
+    else:
+        angle = np.linspace(0, 2 * np.pi, 200)
+        ax.fill(np.cos(angle), np.sin(angle), color="tab:green", alpha=0.12, label="stable region (|z| < 1)")
+        ax.plot(np.cos(angle), np.sin(angle), color="tab:green", lw=1)
+        ax.set_aspect("equal", adjustable="box")
+    markers = "xo^sd*"
+    for i, (label, values) in enumerate(sets.items()):
+        ax.plot(values.real, values.imag, markers[i % len(markers)], ms=10, mew=2,
+                fillstyle="none", label=label)
+    ax.axhline(0, color="0.5", lw=0.8)
+    ax.axvline(0, color="0.5", lw=0.8)
+    ax.set_xlim(-reach, reach)
+    ax.set_ylim(-reach, reach)
+    ax.set_xlabel("real part [1/s]" if dt is None else "real part")
+    ax.set_ylabel("imaginary part [rad/s]" if dt is None else "imaginary part")
+    ax.set_title(title or ("Poles (continuous time)" if dt is None else "Poles (discrete time)"))
+    ax.legend(loc="best")
+    ax.grid(True, alpha=0.3)
+    return fig, ax

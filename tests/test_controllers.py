@@ -1,0 +1,147 @@
+"""Controllers of chapter 3 used as u(t, x) in simulate."""
+
+import numpy as np
+import pytest
+from hypothesis import given, strategies as st
+
+import coursekit as ck
+from conftest import sorted_eig
+
+T = np.linspace(0, 10, 501)
+
+
+def test_state_feedback_around_an_equilibrium_of_a_linear_system_3_100():
+    A, B = np.array([[0, 1], [-2, -3.0]]), np.array([[0], [1.0]])
+    x_eq = np.array([1.0, 0.0])
+    u_eq = np.linalg.lstsq(B, -A @ x_eq, rcond=None)[0]          # 0 = A x* + B u* (3.94)
+    K = ck.place(A, B, [-2, -3])
+    ctrl = ck.StateFeedback(K, x_eq, u_eq)
+    res = ck.simulate(ck.StateSpace(A, B), T, u=ctrl, x0=[-3, 2])
+    np.testing.assert_allclose(res.x[-1], x_eq, atol=1e-6)
+    np.testing.assert_allclose(res.u[-1], u_eq, atol=1e-6)
+    assert "StateFeedback" in repr(ctrl)
+
+
+def test_linear_feedback_holds_the_pendulum_upright_3_92():
+    P = ck.models.pendulum()
+    x_eq, u_eq = np.array([np.pi, 0]), np.array([0.0])
+    A, B = ck.linearize(P, x_eq, u_eq)
+    ctrl = ck.StateFeedback(ck.place(A, B, [-2, -3]), x_eq, u_eq)
+    res = ck.simulate(P, T, u=ctrl, x0=[np.pi - 0.3, 0])
+    assert abs(res.x[-1, 0] - np.pi) < 1e-6
+    # open loop falls
+    res = ck.simulate(P, T, x0=[np.pi - 0.3, 0])
+    assert abs(res.x[-1, 0] - np.pi) > 1
+
+
+def test_feedback_linearization_makes_the_closed_loop_exactly_linear_3_154():
+    m, l, g, d = 0.8, 1.2, 9.81, 0.3
+    P = ck.models.pendulum(m=m, l=l, g=g, d_theta=d)
+    ctrl = ck.PendulumLinearizingController([-2, -3], m=m, l=l, g=g, d_theta=d, theta_ref=np.pi)
+    assert (ctrl.p0, ctrl.p1) == pytest.approx((6, 5))
+    x0 = np.array([0.2, 1.0])                                        # far from upright
+    res = ck.simulate(P, T, u=ctrl, x0=x0)
+    lin = ck.simulate(ck.StateSpace([[0, 1], [-6, -5]]), T, x0=x0 - [np.pi, 0])
+    np.testing.assert_allclose(res.x - [np.pi, 0], lin.x, atol=1e-6)
+
+
+def test_tracking_controller_follows_a_feasible_trajectory_3_104():
+    A, B = np.array([[0, 1], [0, 0.0]]), np.array([[0], [1.0]])
+    x_d = lambda t: np.array([np.sin(t), np.cos(t)])            # noqa: E731
+    u_d = lambda t: np.array([-np.sin(t)])                      # x_d' = A x_d + B u_d (3.101)
+    ctrl = ck.TrackingController(ck.place(A, B, [-3, -4]), x_d, u_d)
+    res = ck.simulate(ck.StateSpace(A, B), T, u=ctrl, x0=[1, -1])
+    err = res.x - np.array([x_d(t) for t in T])
+    assert np.abs(err[0]).max() > 0.9 and np.abs(err[-1]).max() < 1e-6
+    with pytest.raises(ValueError, match=r"x_d\(0\) returned 1 numbers; expected 2"):
+        ck.TrackingController([[1, 2]], lambda t: [0.0], u_d)
+
+
+def test_augmented_matrices_for_a_ccf_are_a_ccf_3_120():
+    a0, a1 = 6.0, -5.0
+    A, B = np.array([[0, 1], [-a0, -a1]]), np.array([[0], [1.0]])
+    A_E, B_E = ck.integral_augment(A, B)
+    np.testing.assert_allclose(A_E, [[0, 1, 0], [0, 0, 1], [0, -a0, -a1]])
+    np.testing.assert_allclose(B_E, [[0], [0], [1]])
+    A_E, B_E = ck.integral_augment(A, B, integrators=2)
+    assert A_E.shape == (4, 4) and A_E[0, 1] == 1 and A_E[1, 2] == 1
+
+
+@given(st.integers(1, 4), st.integers(0, 10_000), st.floats(-2, 2))
+def test_integral_action_removes_a_constant_disturbance(n, seed, d):
+    rng = np.random.default_rng(seed)
+    A, B = rng.normal(size=(n, n)), rng.normal(size=(n, 1))
+    C = np.eye(1, n)
+    A_E, B_E = ck.integral_augment(A, B, C)
+    if np.linalg.cond(ck.ctrb(A_E, B_E)) > 1e6:
+        return
+    K_E = ck.place(A_E, B_E, -np.linspace(1, 2, n + 1))
+    loop = ck.integral_closed_loop(A, B, K_E, C)
+    assert ck.is_stable(loop.A)
+    t = np.linspace(0, 30, 301)
+    w = np.column_stack([np.full_like(t, d), np.zeros_like(t)])     # inputs [d, r]
+    res = ck.simulate(loop, t, w, x0=rng.normal(size=n + 1))
+    assert abs(res.y[-1, 0]) < 1e-6 * max(1, abs(d))
+    # plain state feedback leaves an offset (3.109) whenever d != 0
+    K = ck.place(A, B, -np.linspace(1, 2, n))
+    x_inf = -np.linalg.solve(A + B @ K, B[:, 0] * d)
+    if abs(d) > 0.1 and abs(x_inf[0]) > 1e-3:
+        plain = ck.simulate(ck.StateSpace(A + B @ K, B), t, np.full_like(t, d))
+        assert abs(plain.y[-1, 0] - x_inf[0]) < 1e-6 and abs(plain.y[-1, 0]) > 1e-3
+
+
+def test_double_integrator_rejects_a_ramp_disturbance_3_133():
+    a, b = 1.0, 1.0
+    A_E, B_E = ck.integral_augment([[a]], [[b]], integrators=2)
+    K_E = ck.place(A_E, B_E, [-1, -2, -3])
+    t = np.linspace(0, 25, 501)
+    ramp = np.column_stack([0.5 * t, np.zeros_like(t)])
+    one = ck.integral_closed_loop([[a]], [[b]], ck.place(*ck.integral_augment([[a]], [[b]]), [-1, -2]))
+    two = ck.integral_closed_loop([[a]], [[b]], K_E, integrators=2)
+    y1 = ck.simulate(one, t, ramp).y[-1, 0]
+    y2 = ck.simulate(two, t, ramp).y[-1, 0]
+    assert abs(y1) > 0.1 and abs(y2) < 1e-6
+
+
+def test_reference_through_the_integrator_needs_no_u_star_3_127():
+    # nonlinear pendulum held at 60 degrees by integral action, u* never computed
+    P = ck.models.pendulum(d_theta=0.2)
+    r = np.pi / 3
+    A, B = ck.linearize(P, [r, 0], ck.equilibrium_input(P, [r, 0]))
+    A_E, B_E = ck.integral_augment(A, B)
+    ctrl = ck.IntegralFeedback(ck.place(A_E, B_E, [-3, -3.5, -4]), 1)
+    sys_E = ck.with_integrators(P, r=[r])
+    res = ck.simulate(sys_E, np.linspace(0, 15, 301), u=ctrl, x0=[0, r - 0.2, 0])
+    assert abs(res.x[-1, 1] - r) < 1e-6
+    np.testing.assert_allclose(res.u[-1], 9.81 * np.sin(r), rtol=1e-6)    # it found u* itself
+    assert ctrl.K_I.shape == (1, 1) and ctrl.K.shape == (1, 2)
+
+
+def test_integral_feedback_on_linear_closed_loop_matches_statespace():
+    A, B = np.array([[0, 1], [2, -1.0]]), np.array([[0], [1.0]])
+    A_E, B_E = ck.integral_augment(A, B)
+    K_E = ck.place(A_E, B_E, [-1, -2, -3])
+    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A_E + B_E @ K_E)), [-3, -2, -1], atol=1e-9)
+    t = np.linspace(0, 8, 201)
+    via_nl = ck.simulate(ck.with_integrators(ck.StateSpace(A, B), r=[0.5]), t,
+                         u=ck.IntegralFeedback(K_E, 1), x0=[0, 0, 0])
+    loop = ck.integral_closed_loop(A, B, K_E)
+    via_ss = ck.simulate(loop, t, np.column_stack([np.zeros_like(t), np.full_like(t, 0.5)]))
+    np.testing.assert_allclose(via_nl.x, via_ss.x, atol=1e-7)
+
+
+def test_bad_inputs():
+    with pytest.raises(ValueError, match="x_eq has the wrong length"):
+        ck.StateFeedback([[1, 2]], x_eq=[0, 0, 0])
+    with pytest.raises(ValueError, match="integrators must be 1 or more"):
+        ck.integral_augment([[1]], [[1]], integrators=0)
+    with pytest.raises(ValueError, match="C has the wrong number of columns"):
+        ck.integral_augment([[1, 0], [0, 1]], [[1], [1]], C=[[1, 0, 0]])
+    with pytest.raises(ValueError, match="n_integrator_states must be between 1 and 2"):
+        ck.IntegralFeedback([[1, 2, 3]], 3)
+    with pytest.raises(ValueError, match="K_E has the wrong number of columns"):
+        ck.integral_closed_loop([[1]], [[1]], [[1, 2, 3]])
+    with pytest.raises(ValueError, match="poles has the wrong length"):
+        ck.PendulumLinearizingController([-1, -2, -3])
+    with pytest.raises(ValueError, match="continuous-time"):
+        ck.with_integrators(ck.StateSpace([[0.5]], [[1]], dt=1))

@@ -1,0 +1,67 @@
+"""Equilibria numerically and symbolically (section 3.4.1)."""
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import coursekit as ck
+
+
+def test_pendulum_without_torque_has_down_and_up_3_51():
+    guesses = [[-0.5, 0], [0.5, 0.1], [2.5, 0], [3.5, -0.2]]
+    X = ck.find_equilibria(ck.models.pendulum(), [0], guesses)
+    np.testing.assert_allclose(X, [[0, 0], [np.pi, 0]], atol=1e-9)
+
+
+def test_default_random_guesses_find_all_multiples_of_pi_in_the_box():
+    X = ck.find_equilibria(ck.models.pendulum(), [0], bounds=(-4, 4), count=60)
+    assert np.all(np.abs(X[:, 1]) < 1e-9)
+    k = X[:, 0] / np.pi
+    np.testing.assert_allclose(k, np.round(k), atol=1e-9)
+    assert {-1, 0, 1} <= set(np.round(k).astype(int))
+
+
+def test_constant_torque_moves_the_equilibrium_3_57():
+    m, l, g = 2.0, 0.5, 9.81
+    P = ck.models.pendulum(m=m, l=l, g=g)
+    u = m * g * l * np.sin(np.pi / 4)
+    X = ck.find_equilibria(P, [u], [[0.5, 0]])
+    np.testing.assert_allclose(X, [[np.pi / 4, 0]], atol=1e-9)
+    np.testing.assert_allclose(ck.equilibrium_input(P, [np.pi / 4, 0]), [u], rtol=1e-9)   # (3.59)
+
+
+def test_bare_function_and_discrete_time():
+    X = ck.find_equilibria(lambda x, u: x**2 - 4 + u, [0], n=1, bounds=(-5, 5))
+    np.testing.assert_allclose(X, [[-2], [2]], atol=1e-9)
+    # x(t+1) = x(t)^2 has fixed points 0 and 1 (3.53)
+    X = ck.find_equilibria(lambda x, u: x**2, None, [[-0.2], [0.9], [1.3]], dt=1)
+    np.testing.assert_allclose(X, [[0], [1]], atol=1e-6)
+
+
+def test_linear_system_0_eq_Ax_plus_Bu_3_94():
+    sys = ck.StateSpace([[0, 1], [-2, -3]], [[0], [1]])
+    X = ck.find_equilibria(sys, [4.0], [[0, 0], [5, 5]])
+    np.testing.assert_allclose(X, [[2, 0]], atol=1e-9)
+
+
+def test_unreachable_equilibrium_and_bad_input():
+    with pytest.raises(ValueError, match="not an equilibrium for any constant input"):
+        ck.equilibrium_input(ck.models.pendulum(), [0.3, 1.0])
+    with pytest.raises(ValueError, match="guesses has the wrong number of columns"):
+        ck.find_equilibria(ck.models.pendulum(), [0], [[0, 0, 0]])
+    with pytest.raises(ValueError, match="n is missing"):
+        ck.find_equilibria(lambda x, u: x, None)
+    with pytest.raises(ValueError, match="u_eq has the wrong length"):
+        ck.find_equilibria(ck.models.pendulum(), [0, 1], [[0, 0]])
+
+
+def test_symbolic_pendulum_3_52_and_3_59():
+    x1, x2, u = sp.symbols("x1 x2 u", real=True)
+    g, l, m = sp.symbols("g l m", positive=True)
+    sols = ck.symbolic_equilibria([x2, -g / l * sp.sin(x1)], [x1, x2])
+    assert sols == [{x1: 0, x2: 0}, {x1: sp.pi, x2: 0}]
+    sols = ck.symbolic_equilibria([x2, -g / l * sp.sin(x1) + u / (m * l**2)], [x2, u])
+    assert sols == [{x2: 0, u: g * l * m * sp.sin(x1)}]
+    assert ck.symbolic_equilibria([x1**2], [x1], discrete=True) == [{x1: 0}, {x1: 1}]
+    with pytest.raises(ValueError, match="unknowns must be a non-empty list"):
+        ck.symbolic_equilibria([x1], [])
