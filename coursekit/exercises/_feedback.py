@@ -33,6 +33,7 @@ __all__ = [
     "matrix_feedback",
     "poles_feedback",
     "call_student_function",
+    "rank_decision_feedback",
 ]
 
 #: relative tolerance for answers worked out by hand (0.333 for 1/3 is accepted)
@@ -101,17 +102,21 @@ def _to_array(value, name: str, report: Report, *, dtype=float) -> np.ndarray | 
     return arr
 
 
-def read_matrix(value, name: str, shape: tuple[int, int], report: Report) -> np.ndarray | None:
+def read_matrix(value, name: str, shape: tuple[int, int], report: Report, *,
+                vector: bool = False) -> np.ndarray | None:
     """The student's matrix as a float array, keeping its own shape (for the shape feedback).
 
     A 1-D list or a scalar is accepted where a row or a column is expected
     (it is reshaped); anything else keeps its shape and `matrix_feedback`
-    explains a mismatch.
+    explains a mismatch. With `vector` a list of numbers is expected, and a
+    row or a column of the right length are both accepted.
     """
     arr = _to_array(value, name, report)
     if arr is None:
         return None
     rows, cols = shape
+    if vector and arr.ndim <= 2 and arr.size == rows * cols and (arr.ndim < 2 or 1 in arr.shape):
+        return arr.reshape(shape)
     if arr.ndim == 0:
         arr = arr.reshape(1, 1)
     elif arr.ndim == 1 and (rows == 1 or cols == 1) and arr.size == rows * cols:
@@ -143,17 +148,18 @@ def _entries(mask: np.ndarray) -> str:
 
 def matrix_feedback(answer, expected, name: str, report: Report, *,
                     known_mistakes: Sequence[tuple[Any, str]] = (),
-                    shape_hint: str = "", entry_hint: str = "") -> bool:
+                    shape_hint: str = "", entry_hint: str = "", vector: bool = False) -> bool:
     """Compare the student's `answer` with `expected` and add what is off to `report`.
 
     `known_mistakes` pairs a typical wrong answer (an array of `expected`'s
     shape) with the message to show when the student's answer equals it, e.g.
     ``(-K, "your K has the MATLAB sign ...")``. `shape_hint` explains where the
-    shape comes from, `entry_hint` which equation to recheck for wrong entries.
+    shape comes from, `entry_hint` which equation to recheck for wrong entries;
+    `vector` accepts a row or a column alike (a list of coefficients).
     Returns True when the answer is correct.
     """
     expected = np.asarray(expected, dtype=float)
-    arr = read_matrix(answer, name, expected.shape, report)
+    arr = read_matrix(answer, name, expected.shape, report, vector=vector)
     if arr is None:
         return False
     want = _describe_shape(expected.shape)
@@ -273,3 +279,16 @@ def call_student_function(func: Callable, args: tuple, name: str, size: int,
         report.add(f"{name} returned {arr.size} numbers, expected {size}.")
         return None
     return arr
+
+
+def rank_decision_feedback(rank, decision, true_rank: int, n: int, report: Report, *,
+                           word: str, rank_hint: str, decision_hint: str) -> None:
+    """Check a rank and the yes/no decision "rank = n" of a Kalman criterion (W_c or W_o)."""
+    try:
+        if float(np.asarray(rank, dtype=float)) != true_rank:
+            report.add(f"the rank is off: {rank_hint}")
+    except (TypeError, ValueError):
+        report.add(f"rank must be a whole number: received {rank!r} (np.linalg.matrix_rank).")
+    answer = read_decision(decision, word, report)
+    if answer is not None and answer != (true_rank == n):
+        report.add(f"the decision does not follow the criterion: {decision_hint}")

@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..controllability import ccf_transform, ctrb
-from ._feedback import Report, close, matrix_feedback, read_decision, read_poles
+from ._feedback import Report, close, matrix_feedback, rank_decision_feedback, read_poles
 
 __all__ = [
     "CTRB", "check_ctrb_matrix",
@@ -65,21 +65,12 @@ def check_kalman_decision(rank, controllable) -> bool:
     """Check the rank of Wc for `KALMAN` and the decision of Kalman's criterion."""
     report = Report("Kalman criterion")
     A, B = np.array(KALMAN["A"]), np.array(KALMAN["B"])
-    n = A.shape[0]
-    true_rank = int(np.linalg.matrix_rank(ctrb(A, B)))
-    true_answer = true_rank == n
-    try:
-        r = float(np.asarray(rank, dtype=float))
-        rank_ok = r == true_rank
-        if not rank_ok:
-            report.add("the rank of Wc is off: count the linearly independent columns of "
-                       "[B, AB, A^2 B] (is AB a multiple of B?).")
-    except (TypeError, ValueError):
-        report.add(f"rank must be a whole number: received {rank!r} (np.linalg.matrix_rank(Wc)).")
-    decision = read_decision(controllable, "controllable", report)
-    if decision is not None and decision != true_answer:
-        report.add("the decision does not follow Kalman's criterion: (A, B) is controllable "
-                   "exactly when rank Wc = n (section 2.2.3).")
+    rank_decision_feedback(rank, controllable, int(np.linalg.matrix_rank(ctrb(A, B))), A.shape[0],
+                           report, word="controllable",
+                           rank_hint="count the linearly independent columns of [B, AB, A^2 B] "
+                                     "(is AB a multiple of B?).",
+                           decision_hint="(A, B) is controllable exactly when rank Wc = n "
+                                         "(section 2.2.3).")
     return report.show("rank Wc decides controllability (Kalman's criterion).")
 
 
@@ -165,5 +156,6 @@ def check_trajectory_coefficients(alpha) -> bool:
         (alpha_ok[:, ::-1], "alpha is in descending order: the course writes "
                             "y_d = alpha0 + alpha1 t + alpha2 t^2 + alpha3 t^3 (2.33), so alpha0 first."),
     ], shape_hint="alpha has 4 numbers: [alpha0, alpha1, alpha2, alpha3].",
-        entry_hint="alpha0, alpha1 come from x(0) (2.34); solve the 2x2 system (2.37) for alpha2, alpha3.")
+        entry_hint="alpha0, alpha1 come from x(0) (2.34); solve the 2x2 system (2.37) for alpha2, alpha3.",
+        vector=True)
     return report.show("y_d(t) starts at x0 and ends at xT with these coefficients (2.38).")

@@ -89,24 +89,26 @@ def _gain_feedback(K, A: np.ndarray, B: np.ndarray, poles, report: Report, *, hi
     return ok
 
 
+def _check_gain(K, data: dict, title: str, hint: str, praise: str) -> bool:
+    report = Report(title)
+    _gain_feedback(K, np.array(data["A"]), np.array(data["B"]), data["poles"], report, hint=hint)
+    return report.show(praise)
+
+
 def check_gain_ccf(K) -> bool:
     """Check the gain K (u = K x) placing the poles of `PLACE_CCF`, from (3.42)-(3.44)."""
-    report = Report("pole placement in CCF")
-    A, B = np.array(PLACE_CCF["A"]), np.array(PLACE_CCF["B"])
-    _gain_feedback(K, A, B, PLACE_CCF["poles"], report,
-                   hint="Read a0, a1, a2 from the last row of A (it is -[a0 a1 a2]), expand "
-                        "p(s) = (s - p1)(s - p2)(s - p3) and use k_i = a_(i-1) - p_(i-1) (3.44).")
-    return report.show("eig(A + B K) are the wanted poles (3.44).")
+    return _check_gain(K, PLACE_CCF, "pole placement in CCF",
+                       hint="Read a0, a1, a2 from the last row of A (it is -[a0 a1 a2]), expand "
+                            "p(s) = (s - p1)(s - p2)(s - p3) and use k_i = a_(i-1) - p_(i-1) (3.44).",
+                       praise="eig(A + B K) are the wanted poles (3.44).")
 
 
 def check_gain_general(K) -> bool:
     """Check the gain K (u = K x) placing the poles of `PLACE_GENERAL` via the CCF (3.46)-(3.47)."""
-    report = Report("pole placement, general case")
-    A, B = np.array(PLACE_GENERAL["A"]), np.array(PLACE_GENERAL["B"])
-    _gain_feedback(K, A, B, PLACE_GENERAL["poles"], report,
-                   hint="Find T (2.65), the CCF's a~ from T A T^-1, K~ from (3.46), then "
-                        "K = K~ T (3.47): the gain acts on x, not on z.")
-    return report.show("eig(A + B K) are the wanted poles, K = K~ T (3.47).")
+    return _check_gain(K, PLACE_GENERAL, "pole placement, general case",
+                       hint="Find T (2.65), the CCF's a~ from T A T^-1, K~ from (3.46), then "
+                            "K = K~ T (3.47): the gain acts on x, not on z.",
+                       praise="eig(A + B K) are the wanted poles, K = K~ T (3.47).")
 
 
 def check_pendulum_linearization(A, B) -> bool:

@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..placement import place
-from ._feedback import Report, matrix_feedback, poles_feedback, read_decision, read_poles
+from ._feedback import Report, matrix_feedback, poles_feedback, rank_decision_feedback, read_poles
 
 __all__ = [
     "OBSV", "check_obsv_matrix",
@@ -60,17 +60,12 @@ def check_vehicle_observability(rank, observable) -> bool:
     """Check the rank of Wo for `VEHICLE` and whether it is observable (section 4.2.3)."""
     report = Report("vehicle observability")
     A, C = np.array(VEHICLE["A"]), np.array(VEHICLE["C"])
-    true_rank = int(np.linalg.matrix_rank(_obsv(A, C)))
-    try:
-        if float(np.asarray(rank, dtype=float)) != true_rank:
-            report.add("the rank of Wo is off: compute C and CA and check whether one row is a "
-                       "multiple of the other.")
-    except (TypeError, ValueError):
-        report.add(f"rank must be a whole number: received {rank!r} (np.linalg.matrix_rank(Wo)).")
-    decision = read_decision(observable, "observable", report)
-    if decision is not None and decision != (true_rank == A.shape[0]):
-        report.add("the decision does not follow the criterion: observable exactly when "
-                   "rank Wo = n (section 4.2.3). Can a speedometer tell where the car started?")
+    rank_decision_feedback(rank, observable, int(np.linalg.matrix_rank(_obsv(A, C))), A.shape[0],
+                           report, word="observable",
+                           rank_hint="compute C and CA and check whether one row is a multiple "
+                                     "of the other.",
+                           decision_hint="observable exactly when rank Wo = n (section 4.2.3). "
+                                         "Can a speedometer tell where the car started?")
     return report.show("rank Wo decides observability; a speedometer never reveals the position.")
 
 

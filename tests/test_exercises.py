@@ -1,0 +1,300 @@
+"""The exercise checks: right answers in any form pass, typical mistakes are named.
+
+Every wrong-answer case asserts the printed feedback names the problem and
+never contains the solution's numbers.
+"""
+
+import re
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import coursekit.exercises as ex
+from coursekit.placement import place
+
+MSD = ex.MSD
+CP = ex.COMPARTMENT
+PEN = ex.PENDULUM
+LIN = ex.LINEARIZE
+
+
+def _msd():
+    m, d, k = MSD["m"], MSD["d"], MSD["k"]
+    return [[0, 1], [-k / m, -d / m]], [[0], [1 / m]], [[1, 0]]
+
+
+def _compartment():
+    V1, V2, q, q0, c0 = (CP[k] for k in ("V1", "V2", "q", "q0", "c0"))
+    return [[-(q + q0) / V1, q / V1], [q / V2, -q / V2]], [[c0 / V1], [0]], [[0, 1]]
+
+
+def _pendulum_f(x, u):
+    return [x[1], -PEN["g"] / PEN["l"] * np.sin(x[0]) - PEN["d_theta"] / PEN["m"] * x[1]
+            + u[0] / (PEN["m"] * PEN["l"] ** 2)]
+
+
+def _ode():
+    a0, a1, a2 = ex.ODE["a"]
+    return [[0, 1, 0], [0, 0, 1], [-a0, -a1, -a2]], [[0], [0], [ex.ODE["b"]]], [[1, 0, 0]]
+
+
+def _euler():
+    A, B, Ts = np.array(ex.EULER["A"]), np.array(ex.EULER["B"]), ex.EULER["Ts"]
+    return np.eye(2) + Ts * A, Ts * B
+
+
+def _ctrb():
+    A, B = np.array(ex.CTRB["A"]), np.array(ex.CTRB["B"])
+    return np.hstack([B, A @ B, A @ A @ B])
+
+
+def _ccf_T():
+    A, B = np.array(ex.CCF["A"]), np.array(ex.CCF["B"])
+    T1 = np.array([[0, 1]]) @ np.linalg.inv(np.hstack([B, A @ B]))
+    return np.vstack([T1, T1 @ A])
+
+
+def _car():
+    L, (d1, d2), (dd1, dd2) = ex.CAR["L"], ex.CAR["dF"], ex.CAR["ddF"]
+    v = np.hypot(d1, d2)
+    return v, np.arctan(L * (dd2 * d1 - dd1 * d2) / (d1**2 + d2**2) / v)
+
+
+def _alpha():
+    T, (x10, x20), (x1T, x2T) = ex.TRAJECTORY["T"], ex.TRAJECTORY["x0"], ex.TRAJECTORY["xT"]
+    a2, a3 = np.linalg.solve([[T**2, T**3], [2 * T, 3 * T**2]], [x1T - x10 - x20 * T, x2T - x20])
+    return [x10, x20, a2, a3]
+
+
+def _K(data):
+    return place(np.array(data["A"]), np.array(data["B"]), data["poles"])
+
+
+def _lin():
+    m, l, g, d = LIN["m"], LIN["l"], LIN["g"], LIN["d_theta"]
+    return [[0, 1], [g / l, -d / m]], [[0], [1 / (m * l**2)]]
+
+
+def _obsv():
+    A, C = np.array(ex.OBSV["A"]), np.array(ex.OBSV["C"])
+    return np.vstack([C, C @ A, C @ A @ A])
+
+
+def _L():
+    A, C = np.array(ex.OBSERVER["A"]), np.array(ex.OBSERVER["C"])
+    return -place(A.T, C.T, ex.OBSERVER["poles"]).T
+
+
+def _sep():
+    A, B, C, K, L = (np.array(ex.SEPARATION[k]) for k in ("A", "B", "C", "K", "L"))
+    return np.concatenate([np.linalg.eigvals(A + B @ K), np.linalg.eigvals(A - L @ C)])
+
+
+#: checker -> its correct answer (a tuple of arguments); matrices given as nested lists or arrays
+RIGHT = {
+    "check_msd_state_space": _msd,
+    "check_compartment_state_space": _compartment,
+    "check_ode_realization": _ode,
+    "check_euler_discretization": _euler,
+    "check_ctrb_matrix": lambda: (_ctrb(),),
+    "check_ccf_transform": lambda: (_ccf_T(),),
+    "check_car_flatness": _car,
+    "check_trajectory_coefficients": lambda: (_alpha(),),
+    "check_gain_ccf": lambda: (_K(ex.PLACE_CCF),),
+    "check_gain_general": lambda: (_K(ex.PLACE_GENERAL),),
+    "check_pendulum_linearization": _lin,
+    "check_obsv_matrix": lambda: (_obsv(),),
+    "check_observer_gain": lambda: (_L(),),
+}
+
+
+def _as_list(a):
+    return np.asarray(a, dtype=float).tolist()
+
+
+def _as_sympy(a):
+    arr = np.asarray(a, dtype=float)
+    if arr.ndim == 0:
+        return sp.Float(float(arr))
+    # rationals, as a student working with sympy by hand would have them
+    return sp.Matrix(arr.reshape(arr.shape[0], -1) if arr.ndim == 2 else arr).applyfunc(
+        lambda v: sp.nsimplify(v, tolerance=1e-12, rational=True))
+
+
+def _as_1d(a):
+    arr = np.asarray(a, dtype=float)
+    return arr.ravel() if arr.ndim == 2 and 1 in arr.shape else arr
+
+
+FORMS = {"list": _as_list, "array": np.asarray, "sympy": _as_sympy, "flat": _as_1d}
+
+
+@pytest.mark.parametrize("form", FORMS)
+@pytest.mark.parametrize("name", RIGHT)
+def test_right_answer_in_every_form_is_correct(name, form, capsys):
+    args = tuple(FORMS[form](a) for a in RIGHT[name]())
+    assert getattr(ex, name)(*args) is True
+    out = capsys.readouterr().out
+    assert out.startswith("Correct:"), out
+
+
+@pytest.mark.parametrize("name", ["check_ccf_transform", "check_msd_state_space", "check_trajectory_coefficients"])
+def test_answers_rounded_to_three_digits_are_accepted(name):
+    args = tuple(np.round(np.asarray(a, dtype=float), 3) for a in RIGHT[name]())
+    assert getattr(ex, name)(*args) is True
+
+
+def test_other_right_answers(capsys):
+    assert ex.check_pendulum_f(_pendulum_f)
+    assert ex.check_pendulum_f(lambda x, u: np.array(_pendulum_f(x, np.atleast_1d(u))))  # u as a number
+    assert ex.check_kalman_decision(1, False) and ex.check_kalman_decision(np.int64(1), "no")
+    assert ex.check_stability([True, False, False, True]) and ex.check_stability(np.array([1, 0, 0, 1]) == 1)
+    assert ex.check_vehicle_observability(sp.Integer(1), np.False_)
+    assert ex.check_separation_poles(sorted(_sep().real)) and ex.check_separation_poles(sp.Matrix(_sep().real))
+    v, delta = _car()
+    assert ex.check_car_flatness(-v, -delta)   # driving backwards along the same path
+    assert ex.check_car_flatness([v], np.array([delta]))
+    assert ex.check_ctrb_matrix(sp.Matrix(_ctrb().astype(int)))
+    assert capsys.readouterr().out.count("Correct:") == 12
+
+
+def _swap(a):
+    a = np.array(a, dtype=float)
+    return a[::-1].copy()
+
+
+def _neg_entry(a, index):
+    a = np.array(a, dtype=float)
+    a[index] = -a[index]
+    return a
+
+
+msd_A, msd_B, msd_C = _msd()
+K_ccf, K_gen, L_obs = _K(ex.PLACE_CCF), _K(ex.PLACE_GENERAL), _L()
+v_car, delta_car = _car()
+
+#: (checker, arguments, words the feedback must contain)
+WRONG = [
+    ("check_msd_state_space", (np.array(msd_A).T, msd_B, msd_C), "transposed"),
+    ("check_msd_state_space", (msd_A, [[0, 1 / MSD["m"]]], msd_C), "must be a column"),
+    ("check_msd_state_space", (msd_A, msd_B, [[0, 1]]), "velocity"),
+    ("check_msd_state_space", ([[0, 1], [-MSD["k"], -MSD["d"]]], msd_B, msd_C), "divided by m"),
+    ("check_msd_state_space", (_neg_entry(msd_A, (1, 0)), msd_B, msd_C), "wrong sign"),
+    ("check_msd_state_space", ([[0, 1, 0], [1, 1, 1]], msd_B, msd_C), "wrong shape"),
+    ("check_compartment_state_space", (_compartment()[0], _compartment()[1], [[1, 0]]), "y = c2"),
+    ("check_compartment_state_space", ([[-0.8, 0.6], [0.6, -0.6]], *_compartment()[1:]), "volume"),
+    ("check_pendulum_f", (lambda x, u: [x[1], -PEN["g"] / PEN["l"] * x[0] - PEN["d_theta"] / PEN["m"] * x[1]
+                                        + u[0] / (PEN["m"] * PEN["l"] ** 2)],), "sin(theta)"),
+    ("check_pendulum_f", (lambda x, u: [x[1], -PEN["g"] / PEN["l"] * np.sin(x[0])
+                                        - PEN["d_theta"] / PEN["m"] * x[1] + u[0]],), "divided by m l^2"),
+    ("check_pendulum_f", (lambda x, u: [x[0], 0.0],), "first entry"),
+    ("check_pendulum_f", (lambda x, u: 1 / 0,), "ZeroDivisionError"),
+    ("check_pendulum_f", ("f",), "must be a Python function"),
+    ("check_ode_realization", (np.vstack([np.eye(3)[1:], ex.ODE["a"]]), *_ode()[1:]), "minus"),
+    ("check_ode_realization", (np.vstack([np.eye(3)[1:], -np.array(ex.ODE["a"])[::-1]]), *_ode()[1:]),
+     "reverse order"),
+    ("check_ode_realization", (_ode()[0], [[0], [0], [1]], [[ex.ODE["b"], 0, 0]]), "belongs in B"),
+    ("check_euler_discretization", (ex.EULER["Ts"] * np.array(ex.EULER["A"]), _euler()[1]), "Ad = I + Ts A"),
+    ("check_euler_discretization", (_euler()[0], ex.EULER["B"]), "multiplied by Ts"),
+    ("check_ctrb_matrix", (_ctrb()[:, ::-1],), "reverse order"),
+    ("check_ctrb_matrix", (_ctrb().T,), "transposed"),
+    ("check_ctrb_matrix", (np.hstack([ex.CTRB["A"], _ctrb()[:, 1:]]),), "wrong shape"),
+    ("check_kalman_decision", (3, True), "rank is off"),
+    ("check_kalman_decision", (1, "maybe"), "True or False"),
+    ("check_ccf_transform", (np.linalg.inv(_ccf_T()),), "inverted"),
+    ("check_ccf_transform", (_swap(_ccf_T()),), "wrong order"),
+    ("check_car_flatness", (v_car, np.degrees(delta_car)), "degrees"),
+    ("check_car_flatness", (v_car, -delta_car), "wrong sign"),
+    ("check_car_flatness", (v_car, delta_car * 0 + np.arctan(np.tan(delta_car) / ex.CAR["L"])), "wheelbase"),
+    ("check_car_flatness", (v_car ** 2, delta_car), "v is off"),
+    ("check_trajectory_coefficients", (_alpha()[::-1],), "descending"),
+    ("check_trajectory_coefficients", (_alpha()[:3],), "wrong shape"),
+    ("check_stability", ([True, True, False, True],), "matrix 2"),
+    ("check_stability", ([True, False, True, True],), "real part 0"),
+    ("check_stability", ([True, False],), "4 entries"),
+    ("check_gain_ccf", (-K_ccf,), "MATLAB sign"),
+    ("check_gain_ccf", (K_ccf.T,), "transposed"),
+    ("check_gain_ccf", (K_ccf + [[1, 0, 0]],), "eigenvalues"),
+    ("check_gain_general", (-K_gen,), "MATLAB sign"),
+    ("check_gain_general", (_K(ex.PLACE_GENERAL) @ np.linalg.inv(_ccf_T()),), "off"),
+    ("check_pendulum_linearization", ([[0, 1], [-LIN["g"] / LIN["l"], -LIN["d_theta"] / LIN["m"]]],
+                                      _lin()[1]), "hanging"),
+    ("check_pendulum_linearization", (_lin()[0], [[0, 1]]), "column"),
+    ("check_obsv_matrix", (_obsv().T,), "transposed"),
+    ("check_obsv_matrix", (_obsv()[::-1],), "reverse order"),
+    ("check_vehicle_observability", (2, True), "rank is off"),
+    ("check_observer_gain", (-L_obs,), "A - L C"),
+    ("check_observer_gain", (L_obs.T,), "must be a column"),
+    ("check_observer_gain", (L_obs + [[1], [0]],), "eigenvalues"),
+    ("check_separation_poles", (_sep()[:2],), "4 states"),
+    ("check_separation_poles", (_sep() + 1,), "do not match"),
+]
+
+
+def _solution_numbers(name) -> set[str]:
+    """The entries of the solution (as printed with up to 3 significant digits) that are not trivial."""
+    if name in RIGHT:
+        values = np.concatenate([np.ravel(np.asarray(a, dtype=float)) for a in RIGHT[name]()])
+    elif name == "check_separation_poles":
+        values = _sep().real
+    else:
+        return set()
+    out = set()
+    for v in values:
+        if abs(v) > 1e-9 and abs(abs(v) - 1) > 1e-9:
+            out |= {f"{v:.3g}", f"{v:.4g}", repr(round(float(v), 4))}
+    return out
+
+
+def _numbers_in(text: str) -> set[str]:
+    """Numbers in the feedback, leaving out equation and section numbers, shapes, powers and indices."""
+    text = re.sub(r"\(\d\.\d+\)|section \d(\.\d)+|\d+ x \d+|\(\d+, \d+\)", " ", text)
+    return set(re.findall(r"(?<![\w^.])-?\d+(?:\.\d+)?(?:e-?\d+)?", text))
+
+
+@pytest.mark.parametrize("name, args, words", WRONG, ids=[f"{w[0]}-{w[2]}" for w in WRONG])
+def test_wrong_answer_is_named_and_solution_not_printed(name, args, words, capsys):
+    assert getattr(ex, name)(*args) is False
+    out = capsys.readouterr().out
+    assert out.startswith("Not yet"), out
+    assert words in out, out
+    leaked = _numbers_in(out) & _solution_numbers(name)
+    assert not leaked, f"feedback prints solution numbers {leaked}: {out}"
+
+
+GARBAGE = ["abc", None, {"a": 1}, [[1, 2], [3]], float("nan"), sp.Matrix([[sp.Symbol("k"), 1]])]
+
+
+@pytest.mark.parametrize("garbage", GARBAGE, ids=["str", "None", "dict", "ragged", "nan", "symbol"])
+@pytest.mark.parametrize("name", [n for n in ex.__all__ if n.startswith("check_")])
+def test_garbage_never_raises(name, garbage, capsys):
+    func = getattr(ex, name)
+    nargs = func.__code__.co_argcount
+    assert func(*([garbage] * nargs)) is False
+    out = capsys.readouterr().out
+    assert out.startswith("Not yet") and len(out.splitlines()) >= 2, out
+
+
+def test_garbage_messages_say_what_to_type(capsys):
+    ex.check_gain_ccf("K")
+    ex.check_gain_ccf(sp.Matrix([[sp.Symbol("k1"), 1, 2]]))
+    ex.check_gain_ccf(None)
+    ex.check_gain_ccf(np.zeros((2, 2, 2)))
+    out = capsys.readouterr().out
+    assert "not a string" in out and "symbols" in out and "placeholder" in out and "dimensions" in out
+
+
+def test_exercises_module_is_not_loaded_by_import_coursekit_and_sympy_stays_lazy():
+    import subprocess
+    import sys
+    code = ("import sys, coursekit, coursekit.exercises; "
+            "print('sympy' in sys.modules, 'matplotlib' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False", "False"]
+
+
+def test_leak_detector_sees_numbers_but_not_equation_references():
+    assert {"-9", "-6", "0.5"} <= _numbers_in("K = [[-9, -6]], T = [[0.5, 0]]")
+    assert _numbers_in("see (3.47) and section 2.2.3; entries (2, 1); A^2 B is 3 x 3") == set()
+    assert "-9" in _solution_numbers("check_gain_general")
