@@ -17,7 +17,7 @@ __version__ = "0.1.0"
 # One module per job; each line lists the modules of one chapter of the notes.
 _MODULES = (
     # chapter 1: representations
-    "systems", "simulation",
+    "systems", "simulation", "realization", "interconnect", "plotting",
     # chapter 2: controllability and open-loop control
     "controllability",
     # chapter 3: stability and state feedback

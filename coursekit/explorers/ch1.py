@@ -1,0 +1,169 @@
+"""Explorers of chapter 1: the Euler step, and the mass-spring-damper parameters.
+
+Each explorer is a pure ``*_compute`` function (numbers only, unit-tested)
+and a ``*_explorer()`` factory that wires it to sliders.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import models
+from .._validation import as_scalar
+from ..realization import euler_discretize
+from ..simulation import simulate
+from ..systems import StateSpace
+from ._base import Explorer, dropdown, slider
+
+__all__ = ["EULER_EXAMPLES", "euler_compute", "euler_explorer", "msd_compute", "msd_explorer"]
+
+#: The systems the Euler explorer offers: (system, x0, t_end, state unit).
+EULER_EXAMPLES = {
+    "first order (1.12)": (StateSpace([[-3.0]], name="y' = -3 y"), [6.0], 3.0, "-"),
+    "mass-spring-damper (1.57)": (models.mass_spring_damper(m=1.0, d=0.5, k=2.0), [1.0, 0.0], 15.0, "m"),
+}
+
+
+def _euler_limit(A: np.ndarray) -> float:
+    """Largest Ts with |1 + Ts lambda| < 1 for every eigenvalue lambda of A.
+
+    0 when A has an eigenvalue with Re >= 0: then no step makes Euler stable.
+    """
+    lam = np.linalg.eigvals(A)
+    if np.any(lam.real >= 0):
+        return 0.0
+    # |1 + Ts lam|^2 < 1  <=>  Ts < -2 Re(lam) / |lam|^2
+    return float(np.min(-2 * lam.real / np.abs(lam) ** 2))
+
+
+def euler_compute(Ts: float, example: str = "first order (1.12)", samples: int = 1500) -> dict:
+    """Exact response against its Euler discretization (1.43) for the step `Ts`.
+
+    Returns a dict with the exact curve ``t, x`` (first state, `samples`
+    points), the Euler samples ``tk, xk``, the exact value at those times
+    ``xk_exact``, ``max_error``, the spectral radius ``rho`` of ``I + Ts A``,
+    ``stable`` (rho < 1), the stability limit ``Ts_max`` and the ``unit``.
+    """
+    Ts = as_scalar(Ts, "Ts", positive=True)
+    if example not in EULER_EXAMPLES:
+        raise ValueError(f"example must be one of {list(EULER_EXAMPLES)}: received {example!r}.")
+    sys, x0, t_end, unit = EULER_EXAMPLES[example]
+    t = np.linspace(0.0, t_end, samples)
+    exact = simulate(sys, t, x0=x0)
+    disc = euler_discretize(sys, Ts)
+    tk = np.arange(int(np.floor(t_end / Ts + 1e-9)) + 1) * Ts
+    euler = simulate(disc, tk, x0=x0)
+    # the exact solution at the sampling instants, x(k Ts) = e^{A k Ts} x0
+    xk_exact = simulate(sys, tk, x0=x0).x[:, 0] if tk.size > 1 else np.asarray(x0[:1], float)
+    rho = float(max(abs(np.linalg.eigvals(disc.A))))
+    return dict(t=t, x=exact.x[:, 0], tk=tk, xk=euler.x[:, 0], xk_exact=xk_exact,
+                max_error=float(np.max(np.abs(euler.x[:, 0] - xk_exact))), rho=rho,
+                stable=rho < 1.0, Ts_max=_euler_limit(sys.A), Ts=Ts, unit=unit, example=example)
+
+
+def euler_explorer() -> Explorer:
+    """Sliders for the Euler step Ts: exact solution, Euler samples and error."""
+    def draw(fig):
+        ax, ax_err = fig.subplots(2, 1, sharex=True)
+        exact, = ax.plot([], [], "k", linewidth=2, label="exact")
+        approx, = ax.plot([], [], "o--", markersize=3, linewidth=0.8, color="C1", label="Euler (1.43)")
+        err, = ax_err.semilogy([], [], color="C1")
+        ax.set_ylabel("x1")
+        ax.legend(loc="upper right")
+        ax.grid(True, alpha=0.4)
+        ax_err.set_ylabel("|x_Euler(k) - x(k Ts)|")
+        ax_err.set_xlabel("time t [s]")
+        ax_err.grid(True, which="both", alpha=0.3)
+        return dict(ax=ax, ax_err=ax_err, exact=exact, approx=approx, err=err)
+
+    def update(h, r):
+        h["exact"].set_data(r["t"], r["x"])
+        h["approx"].set_data(r["tk"], r["xk"])
+        h["approx"].set_marker("o" if r["tk"].size <= 80 else "None")
+        # from k = 1 on: at k = 0 both start at x0 and the error is exactly zero
+        h["err"].set_data(r["tk"][1:], np.maximum(np.abs(r["xk"] - r["xk_exact"])[1:], 1e-16))
+        span = max(float(np.ptp(r["x"])), 1e-12)
+        h["ax"].set_xlim(0, r["t"][-1])
+        h["ax"].set_ylim(r["x"].min() - 0.5 * span, r["x"].max() + 0.5 * span)
+        h["ax"].set_ylabel(f"x1 [{r['unit']}]")
+        h["ax_err"].set_ylabel(f"|error| [{r['unit']}]")
+        h["ax_err"].relim()
+        h["ax_err"].autoscale_view()
+        verdict = "< 1: stable" if r["stable"] else ">= 1: UNSTABLE"
+        h["ax"].set_title(f"{r['example']}, Ts = {r['Ts']:.3g} s, max error {r['max_error']:.2g}\n"
+                          f"max|eig(I + Ts A)| = {r['rho']:.3f} {verdict} (stable if Ts < {r['Ts_max']:.3g})")
+
+    return Explorer(
+        title="Euler discretization (1.43): step Ts against the exact solution",
+        controls=dict(Ts=slider(0.1, 0.01, 1.0, 0.01, "Ts [s]"),
+                      example=dropdown(list(EULER_EXAMPLES), "first order (1.12)", "system")),
+        compute=euler_compute, draw=draw, update=update, figsize=(8, 5.5))
+
+
+def msd_compute(m: float, d: float, k: float, experiment: str = "step", t_end: float = 20.0,
+                samples: int = 1500) -> dict:
+    """Response of the mass-spring-damper (1.54)/(1.57) for the parameters m, d, k.
+
+    ``experiment="step"``: u = 1 N from rest (the position settles at 1/k);
+    ``"initial"``: u = 0 from y(0) = 1 m, y'(0) = 0.
+    Returns ``t, y`` (position), ``v`` (velocity), ``u``, the natural
+    frequency ``omega_n = sqrt(k/m)``, the damping ratio
+    ``zeta = d / (2 sqrt(k m))`` and the ``poles`` (eigenvalues of A).
+    """
+    m = as_scalar(m, "m", positive=True)
+    k = as_scalar(k, "k", positive=True)
+    d = as_scalar(d, "d")
+    if experiment not in ("step", "initial"):
+        raise ValueError(f"experiment must be 'step' or 'initial': received {experiment!r}.")
+    sys = models.mass_spring_damper(m=m, d=d, k=k)
+    t = np.linspace(0.0, float(t_end), samples)
+    if experiment == "step":
+        res = simulate(sys, t, u=np.ones((samples, 1)))
+    else:
+        res = simulate(sys, t, x0=[1.0, 0.0])
+    return dict(t=t, y=res.x[:, 0], v=res.x[:, 1], u=res.u[:, 0], omega_n=float(np.sqrt(k / m)),
+                zeta=float(d / (2 * np.sqrt(k * m))), poles=np.linalg.eigvals(sys.A),
+                experiment=experiment, m=m, d=d, k=k)
+
+
+def msd_explorer() -> Explorer:
+    """Sliders for m, d, k of the mass-spring-damper: response and poles."""
+    def draw(fig):
+        ax, ax_p = fig.subplots(1, 2, width_ratios=[2.2, 1])
+        y, = ax.plot([], [], label="position y [m]")
+        v, = ax.plot([], [], label="velocity y' [m/s]")
+        ax.set_xlabel("time t [s]")
+        ax.set_ylabel("y [m], y' [m/s]")
+        ax.legend(loc="upper right")
+        ax.grid(True, alpha=0.4)
+        poles, = ax_p.plot([], [], "x", markersize=10, markeredgewidth=2, color="C3")
+        ax_p.axvline(0, color="0.5", linewidth=0.8)
+        ax_p.axhline(0, color="0.5", linewidth=0.8)
+        ax_p.set_xlabel("Re s [1/s]")
+        ax_p.set_ylabel("Im s [rad/s]")
+        ax_p.set_title("poles = eig(A)")
+        ax_p.grid(True, alpha=0.4)
+        title = fig.suptitle("")
+        return dict(ax=ax, ax_p=ax_p, y=y, v=v, poles=poles, title=title)
+
+    def update(h, r):
+        h["y"].set_data(r["t"], r["y"])
+        h["v"].set_data(r["t"], r["v"])
+        h["poles"].set_data(r["poles"].real, r["poles"].imag)
+        for ax in (h["ax"], h["ax_p"]):
+            ax.relim()
+            ax.autoscale_view()
+        lim = 1.2 * max(1.0, float(np.abs(r["poles"]).max()))
+        h["ax_p"].set_xlim(-lim, 0.3 * lim)
+        h["ax_p"].set_ylim(-lim, lim)
+        h["title"].set_text(f"{r['experiment']} response, m = {r['m']:g} kg, d = {r['d']:g} N s/m, "
+                            f"k = {r['k']:g} N/m: damping ratio zeta = {r['zeta']:.3f}, "
+                            f"natural frequency omega_n = {r['omega_n']:.3f} rad/s")
+
+    return Explorer(
+        title="Mass-spring-damper (1.54): parameters m, d, k against the response",
+        controls=dict(m=slider(1.0, 0.1, 5.0, 0.1, "m [kg]"),
+                      d=slider(0.5, 0.0, 5.0, 0.05, "d [N s/m]"),
+                      k=slider(2.0, 0.1, 10.0, 0.1, "k [N/m]"),
+                      experiment=dropdown(["step", "initial"], "step", "experiment")),
+        compute=msd_compute, draw=draw, update=update, figsize=(11, 4.5))
