@@ -1,0 +1,214 @@
+"""Observability (section 4.2), the observability canonical form (4.4-4.5) and
+observer gains by pole placement (4.46, 4.60, 4.84).
+
+Observability is the dual of controllability: (A, C) is observable exactly
+when (A^T, C^T) is controllable, since the observability matrix Wo of (4.15)
+is the transpose of the controllability matrix of (A^T, C^T). This module
+therefore reuses the helpers of `controllability` and `placement` instead
+of repeating them.
+
+* `obsv(A, C)` builds Wo = [C; CA; ...; CA^(n-1)] (4.12), (4.15);
+* `is_observable(A, C)` is Kalman's criterion, rank Wo = n, with an SVD;
+* `ocf_transform(A, C)` returns T with z = T x in OCF (4.31)-(4.32);
+* `place_observer(A, C, poles)` returns L with eig(A - L C) = poles.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from ._validation import as_matrix, as_poles, as_square
+from .controllability import _ctrb, _rank
+from .placement import _multiplicities, place, poly_from_roots
+
+__all__ = [
+    "NotObservableError",
+    "obsv",
+    "obsv_singular_values",
+    "is_observable",
+    "ocf_transform",
+    "place_observer",
+    "place_observer_details",
+    "ObserverDetails",
+]
+
+
+class NotObservableError(ValueError):
+    """Raised when an algorithm needs an observable pair (A, C) and it is not."""
+
+
+def _obs_pair(A, C):
+    """Validate (A, C): A square (n, n), C of shape (p, n); a 1-D C is one row."""
+    A = as_square(A, "A")
+    n = A.shape[0]
+    C = as_matrix(C, "C", cols=n, cols_why=f"one per state, since A is {n}x{n}",
+                  rows=1 if np.ndim(C) == 1 else None)
+    if C.shape[0] == 0:
+        raise ValueError("C has no rows: the system has no measurement to estimate the state from.")
+    return A, C
+
+
+def _obsv(A: np.ndarray, C: np.ndarray) -> np.ndarray:
+    # duality: Wo = [C; CA; ...; CA^(n-1)] = Wc(A^T, C^T)^T
+    return _ctrb(A.T, C.T).T
+
+
+def obsv(A, C) -> np.ndarray:
+    """Observability matrix Wo = [C; CA; CA^2; ...; CA^(n-1)] (4.15), shape (n p, n).
+
+    With one output it is the n x n matrix of (4.12); with p outputs the
+    blocks C A^i have p rows each.
+    """
+    A, C = _obs_pair(A, C)
+    return _obsv(A, C)
+
+
+def obsv_singular_values(A, C) -> np.ndarray:
+    """Singular values of Wo, largest first: the smallest says how close to unobservable."""
+    return np.linalg.svd(obsv(A, C), compute_uv=False)
+
+
+def is_observable(A, C, *, tol: float | None = None) -> bool:
+    """Kalman's criterion (4.14)-(4.15): rank Wo = n.
+
+    The rank counts singular values of Wo above `tol` (default: NumPy's
+    ``matrix_rank`` rule), which also works for several outputs, where Wo
+    is not square and the notes' ``det(Wo) != 0`` test does not apply.
+    """
+    A, C = _obs_pair(A, C)
+    return _rank(_obsv(A, C), tol) == A.shape[0]
+
+
+def require_observable(A: np.ndarray, C: np.ndarray, *, purpose: str) -> np.ndarray:
+    """Return Wo, or raise NotObservableError explaining what failed and why it matters."""
+    W = _obsv(A, C)
+    r = _rank(W, None)
+    n = A.shape[0]
+    if r < n:
+        raise NotObservableError(
+            f"(A, C) is not observable, so {purpose} is impossible: the observability "
+            f"matrix Wo = [C; CA; ...; CA^{n - 1}] (4.15) has rank {r} < n = {n}. "
+            f"{n - r} direction(s) of the state leave no trace in y; measure another "
+            "combination of the states (change C), or check A (e.g. with is_observable "
+            "and obsv_singular_values)."
+        )
+    return W
+
+
+def _single_output(C: np.ndarray, what: str) -> None:
+    if C.shape[0] != 1:
+        raise ValueError(
+            f"C must have a single row for {what}: received shape {C.shape}; the OCF (4.31) "
+            "is defined for one output. Pick one row of C, or use place_observer() "
+            "which handles several outputs."
+        )
+
+
+def ocf_transform(A, C) -> np.ndarray:
+    """Transform T such that z = T x puts (A, C) in observability canonical form.
+
+    Implements (4.48)-(4.56): with V = T^{-1} = [V_1, ..., V_n], the first
+    column solves Wo V_1 = e_n (4.55)-(4.56) and the others follow from
+    V_{i+1} = A V_i (4.52). Then ``T A T^{-1}`` has ones on the subdiagonal
+    and last column ``-[a_0 ... a_{n-1}]``, and ``C T^{-1} = e_n^T`` (4.31)-(4.32).
+
+    Single output only (C of shape (1, n)). Raises `NotObservableError` when
+    Wo is singular: an unobservable system has no OCF.
+    """
+    A, C = _obs_pair(A, C)
+    _single_output(C, "the OCF")
+    n = A.shape[0]
+    W = require_observable(A, C, purpose="a transform to the observability canonical form")
+    e_n = np.zeros(n)
+    e_n[-1] = 1.0
+    V = np.empty((n, n))
+    # (4.56): V_1 = Wo^{-1} C~^T with C~^T = e_n, solved without forming Wo^{-1}
+    V[:, 0] = np.linalg.solve(W, e_n)
+    # (4.52): V_{i+1} = A V_i
+    for i in range(1, n):
+        V[:, i] = A @ V[:, i - 1]
+    # (4.49): T = V^{-1}
+    return np.linalg.inv(V)
+
+
+@dataclass(repr=False)
+class ObserverDetails:
+    """The intermediate quantities of the single-output method (4.46), (4.60).
+
+    Attributes: ``T`` (z = T x in OCF), ``V`` (= T^{-1}), ``A_ocf`` (T A V),
+    ``C_ocf`` (C V = e_n^T), ``a`` (open-loop coefficients a_0..a_{n-1}),
+    ``p`` (desired coefficients p_0..p_{n-1}), ``L_ocf`` (gain in z
+    coordinates, l_i = p_{i-1} - a_{i-1}) and ``L`` (= V L_ocf).
+    """
+
+    T: np.ndarray
+    V: np.ndarray
+    A_ocf: np.ndarray
+    C_ocf: np.ndarray
+    a: np.ndarray
+    p: np.ndarray
+    L_ocf: np.ndarray
+    L: np.ndarray
+
+    def __repr__(self) -> str:
+        fmt = lambda v: np.array2string(np.asarray(v), precision=4, suppress_small=True,  # noqa: E731
+                                        prefix=" " * 9)
+        names = ("T", "V", "A_ocf", "C_ocf", "a", "p", "L_ocf", "L")
+        return "\n".join(f"{k:>6} = {fmt(getattr(self, k))}" for k in names)
+
+
+def place_observer_details(A, C, poles) -> ObserverDetails:
+    """Single-output observer gain through the OCF, returning every step (4.46), (4.60)."""
+    A, C = _obs_pair(A, C)
+    n = A.shape[0]
+    poles = as_poles(poles, "poles", count=n)
+    T = ocf_transform(A, C)
+    V = np.linalg.inv(T)
+    # (4.49): A~ = V^{-1} A V, C~ = C V
+    A_ocf, C_ocf = T @ A @ V, C @ V
+    a = -A_ocf[:, -1].copy()              # last column of the OCF is -[a_0 ... a_{n-1}]
+    p = poly_from_roots(poles)            # desired p(s) of the error dynamics
+    L_ocf = (p - a).reshape(n, 1)         # (4.46): l_i = p_{i-1} - a_{i-1}
+    L = V @ L_ocf                         # (4.60): L = V L~
+    return ObserverDetails(T=T, V=V, A_ocf=A_ocf, C_ocf=C_ocf, a=a, p=p, L_ocf=L_ocf, L=L)
+
+
+def place_observer(A, C, poles) -> np.ndarray:
+    """Observer gain L, shape (n, p), with eig(A - L C) = poles.
+
+    The observer is x̂' = A x̂ + B u + L (y - C x̂) (4.25), with error
+    dynamics x̃' = (A - L C) x̃ (4.27). The sign convention matches MATLAB's
+    ``place(A', C', P)'`` of (4.84) (no minus sign, unlike the state-feedback
+    gain of (4.78)).
+
+    * One output: the notes' method (4.46), (4.60): transform to the OCF with
+      `ocf_transform`, compare the open-loop and desired characteristic
+      polynomials, map back with L = V L~. Repeated poles are fine.
+      `place_observer_details` shows the intermediate quantities.
+    * Several outputs: duality (4.82)-(4.84). eig(A - L C) = eig(A^T - C^T L^T),
+      so L^T is a state-feedback gain for the pair (A^T, C^T); with the
+      course's u = K x convention, ``L = -place(A^T, C^T, poles)^T``. A pole
+      may then be repeated at most rank(C) times.
+
+    Raises `NotObservableError` if (A, C) is not observable and `ValueError`
+    for a wrong number of poles or a complex pole without its conjugate.
+    """
+    A, C = _obs_pair(A, C)
+    n, p = A.shape[0], C.shape[0]
+    poles = as_poles(poles, "poles", count=n)
+    if p == 1:
+        return place_observer_details(A, C, poles).L
+    require_observable(A, C, purpose="placing every pole of the estimation error dynamics")
+    rank_C = _rank(C, None)
+    too_many = [(v, c) for v, c in zip(*_multiplicities(poles)) if c > rank_C]
+    if too_many:
+        v, c = too_many[0]
+        raise ValueError(
+            f"poles repeats {v:g} {c} times, but with several outputs a pole can be repeated "
+            f"at most rank(C) = {rank_C} times by the robust method; spread the poles slightly "
+            "(e.g. -2, -2.1, -2.2) or use a single output."
+        )
+    # (4.84): L^T = place(A^T, C^T, P) in MATLAB's sign, i.e. L = -K^T in the course's
+    return -place(A.T, C.T, poles).T

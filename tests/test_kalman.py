@@ -1,0 +1,215 @@
+"""kalman_gain, the Kalman-Bucy filter, the EKF and the noise helpers (section 4.7)."""
+
+import control
+import numpy as np
+import pytest
+from hypothesis import given, settings, strategies as st
+
+import coursekit as ck
+
+A = np.array([[0, 1], [-2, -0.5]])      # mass-spring-damper, position measured
+B = np.array([[0], [1.0]])
+C = np.array([[1, 0.0]])
+Q = np.diag([0.0, 0.5])
+R = np.array([[0.02]])
+
+
+def _riccati_exact(A, C, Q, R, P0, t):
+    """P(t) of (4.88) in closed form: P = Y X^{-1} with [X; Y]' = [[-A^T, C^T R^-1 C], [Q, A]] [X; Y]."""
+    from scipy.linalg import expm
+    n = A.shape[0]
+    H = np.block([[-A.T, C.T @ np.linalg.solve(R, C)], [Q, A]])
+    XY = expm(H * t) @ np.vstack([np.eye(n), P0])
+    return np.linalg.solve(XY[:n].T, XY[n:].T).T
+
+
+def _random_detectable(n, p, seed):
+    rng = np.random.default_rng(seed)
+    A_, C_ = rng.normal(size=(n, n)), rng.normal(size=(p, n))
+    if np.linalg.cond(ck.obsv(A_, C_)) > 1e5:
+        return None
+    return A_, C_
+
+
+@given(st.integers(1, 5), st.integers(1, 2), st.integers(0, 10_000))
+def test_kalman_gain_matches_lqe_and_solves_the_are(n, p, seed):
+    drawn = _random_detectable(n, p, seed)
+    if drawn is None:
+        return
+    A_, C_ = drawn
+    rng = np.random.default_rng(seed + 1)
+    G = rng.normal(size=(n, n))
+    Q_, R_ = G @ G.T + 0.1 * np.eye(n), np.diag(rng.uniform(0.1, 2, size=p))
+    L, P = ck.kalman_gain(A_, C_, Q_, R_)
+    assert L.shape == (n, p) and P.shape == (n, n)
+    residual = A_ @ P + P @ A_.T - P @ C_.T @ np.linalg.solve(R_, C_ @ P) + Q_
+    assert np.abs(residual).max() < 1e-7 * max(1.0, np.abs(P).max()) ** 2
+    assert np.linalg.eigvalsh(P).min() > 0
+    assert np.linalg.eigvals(A_ - L @ C_).real.max() < 0
+    L_ref, P_ref, _ = control.lqe(A_, np.eye(n), C_, Q_, R_)   # same sign: observer A - L C
+    np.testing.assert_allclose(L, L_ref, rtol=1e-6, atol=1e-8 * np.abs(L_ref).max())
+    np.testing.assert_allclose(P, P_ref, rtol=1e-6, atol=1e-8 * np.abs(P_ref).max())
+
+
+def test_kalman_gain_is_the_dual_of_lqr():
+    # LQR for (A^T, C^T) with weights (Q, R) gives K_lqr = R^-1 C P, so L = K_lqr^T
+    K_lqr, S, _ = control.lqr(A.T, C.T, Q + 1e-3 * np.eye(2), R)
+    L, P = ck.kalman_gain(A, C, Q + 1e-3 * np.eye(2), R)
+    np.testing.assert_allclose(P, S, rtol=1e-8)
+    np.testing.assert_allclose(L, K_lqr.T, rtol=1e-8)
+
+
+def test_riccati_ode_follows_the_closed_form_and_tends_to_the_are():
+    t = np.linspace(0, 20, 2001)
+    sys = ck.StateSpace(A, B, C)
+    P0 = np.diag([2.0, 1.0])
+    res = ck.kalman_bucy(sys, t, None, np.zeros((t.size, 1)), Q, R, P0, [0, 0], substeps=4)
+    for k in (5, 50, 300):
+        np.testing.assert_allclose(res.P[k], _riccati_exact(A, C, Q, R, P0, t[k]), rtol=1e-5, atol=1e-7)
+    L, P = ck.kalman_gain(A, C, Q, R)
+    np.testing.assert_allclose(res.P[-1], P, atol=1e-9)
+    np.testing.assert_allclose(res.L[-1], L, atol=1e-8)
+    np.testing.assert_allclose(res.P[0], P0)
+    assert np.abs(res.P[20] - P).max() > 1e-2          # it really moved
+
+
+@settings(max_examples=5)
+@given(st.integers(1, 3), st.integers(0, 10_000))
+def test_riccati_ode_limit_is_the_are_solution_random(n, seed):
+    drawn = _random_detectable(n, 1, seed)
+    if drawn is None:
+        return
+    A_, C_ = drawn
+    Q_, R_ = np.eye(n), np.array([[0.5]])
+    L, P = ck.kalman_gain(A_, C_, Q_, R_)
+    rate = -np.linalg.eigvals(A_ - L @ C_).real.max()
+    if rate < 0.2:
+        return
+    t = np.linspace(0, 30 / rate, 1000)
+    res = ck.kalman_bucy(ck.StateSpace(A_, np.zeros((n, 1)), C_), t, None, np.zeros((t.size, 1)),
+                         Q_, R_, np.eye(n), np.zeros(n), substeps=2)
+    np.testing.assert_allclose(res.P[-1], P, rtol=1e-6, atol=1e-7 * max(1.0, np.abs(P).max()))
+
+
+def test_ekf_on_a_linear_system_reproduces_kalman_bucy():
+    t = np.linspace(0, 8, 801)
+    sys = ck.StateSpace(A, B, C)
+    u = np.sin(t)[:, None]
+    data = ck.simulate_with_noise(sys, t, u, x0=[1, 0], Q=Q, R=R, seed=4)
+    P0 = np.eye(2)
+    kb = ck.kalman_bucy(sys, t, u, data.y, Q, R, P0, [0, 0])
+    nl = ck.NonlinearSystem(lambda x, v: A @ x + B @ v, n=2, m=1, h=lambda x, v: C @ x)
+    ekf = ck.extended_kalman_filter(nl, t, u, data.y, Q, R, P0, [0, 0])
+    np.testing.assert_allclose(ekf.x, kb.x, atol=1e-8)
+    np.testing.assert_allclose(ekf.P, kb.P, atol=1e-8)
+    given_jac = ck.extended_kalman_filter(nl, t, u, data.y, Q, R, P0, [0, 0],
+                                          dfdx=lambda x, v: A, dhdx=lambda x, v: C)
+    np.testing.assert_allclose(given_jac.x, kb.x, atol=1e-12)
+    # and the estimate does track the true state
+    assert np.sqrt(np.mean((kb.x[200:] - data.x[200:]) ** 2)) < 0.5
+
+
+def test_ekf_pendulum_converges_from_a_wrong_estimate():
+    pend = ck.models.pendulum(d_theta=0.2)
+    meas = ck.NonlinearSystem(pend.f, n=2, m=1, h=lambda x, u: np.array([np.sin(x[0])]))
+    t = np.linspace(0, 10, 1001)
+    data = ck.simulate_with_noise(meas, t, None, x0=[1.0, 0.0], Q=np.diag([0, 1e-3]),
+                                  R=[[1e-4]], seed=5)
+    ekf = ck.extended_kalman_filter(meas, t, None, data.y, np.diag([1e-4, 1e-2]), [[1e-4]],
+                                    np.eye(2), [0.3, 1.0])
+    assert np.abs(ekf.x[0] - data.x[0]).max() > 0.5
+    assert np.abs(ekf.x[-100:] - data.x[-100:]).max() < 0.05
+    assert ekf.sigma.shape == (t.size, 2)
+
+
+def test_noise_units_error_covariance_matches_p():
+    """A steady-state Kalman observer on simulated data: its error covariance is P.
+
+    This checks the documented units: samples of covariance intensity / dt.
+    """
+    dt = 0.01
+    t = np.arange(0, 400, dt)
+    sys = ck.StateSpace(A, B, C)
+    data = ck.simulate_with_noise(sys, t, None, Q=Q, R=R, seed=3)
+    L, P = ck.kalman_gain(A, C, Q, R)
+    est = ck.simulate(ck.observer_system(sys, L), t, u=np.hstack([data.u, data.y]))
+    err = est.x[1000:] - data.x[1000:]
+    np.testing.assert_allclose(np.cov(err.T), P, rtol=0.15, atol=0.01)
+    # the state itself: stationary covariance from the Lyapunov equation A X + X A^T + Q = 0
+    np.testing.assert_allclose(np.cov(data.x[1000:].T), np.diag([0.25, 0.5]), rtol=0.2, atol=0.02)
+
+
+def test_white_noise_variance_scales_with_one_over_dt():
+    for dt in (0.1, 0.01):
+        t = np.arange(20000) * dt
+        w = ck.white_noise(t, [[0.5]], seed=1)
+        assert w.shape == (20000, 1)
+        assert abs(w.var() * dt / 0.5 - 1) < 0.05
+    w2 = ck.white_noise(np.arange(5000) * 0.1, np.diag([1.0, 4.0]), seed=2)
+    np.testing.assert_allclose(np.cov(w2.T), np.diag([10.0, 40.0]), rtol=0.1, atol=1.0)
+    np.testing.assert_array_equal(ck.white_noise(t, 1.0, seed=7), ck.white_noise(t, 1.0, seed=7))
+
+
+def test_simulate_with_noise_is_seeded_and_noise_free_limit():
+    t = np.linspace(0, 3, 301)
+    sys = ck.StateSpace(A, B, C)
+    a = ck.simulate_with_noise(sys, t, np.ones((301, 1)), x0=[1, 0], Q=Q, R=R, seed=11)
+    b = ck.simulate_with_noise(sys, t, np.ones((301, 1)), x0=[1, 0], Q=Q, R=R,
+                               seed=np.random.default_rng(11))
+    np.testing.assert_array_equal(a.y, b.y)
+    quiet = ck.simulate_with_noise(sys, t, np.ones((301, 1)), x0=[1, 0], Q=np.zeros((2, 2)),
+                                   R=[[0]], seed=0)
+    exact = ck.simulate(sys, t, np.ones((301, 1)), x0=[1, 0])
+    np.testing.assert_allclose(quiet.x, exact.x, atol=1e-10)
+    pend = ck.models.pendulum()
+    quiet = ck.simulate_with_noise(pend, t, None, x0=[0.5, 0], Q=np.zeros((2, 2)), R=[[0]])
+    np.testing.assert_allclose(quiet.x, ck.simulate(pend, t, x0=[0.5, 0]).x, atol=1e-6)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(R=[[0.0]]), r"R must be positive definite"),
+    (dict(Q=[[1, 2], [0, 1]]), r"Q must be symmetric"),
+    (dict(Q=np.diag([1, -1.0])), r"Q must be positive semidefinite"),
+    (dict(Q=np.eye(3)), r"Q has the wrong size: received shape \(3, 3\), expected \(2, 2\)"),
+])
+def test_kalman_gain_bad_weights(kwargs, message):
+    args = dict(A=A, C=C, Q=Q, R=R) | kwargs
+    with pytest.raises(ValueError, match=message):
+        ck.kalman_gain(**args)
+
+
+def test_kalman_gain_undetectable():
+    with pytest.raises(ValueError, match=r"no stabilizing solution"):
+        ck.kalman_gain(np.diag([1.0, -1.0]), [[0, 1]], np.eye(2), [[1]])
+
+
+def test_filter_bad_inputs():
+    t = np.linspace(0, 1, 11)
+    sys = ck.StateSpace(A, B, C)
+    with pytest.raises(ValueError, match=r"y has the wrong number of rows"):
+        ck.kalman_bucy(sys, t, None, np.zeros((10, 1)), Q, R, np.eye(2), [0, 0])
+    with pytest.raises(ValueError, match=r"y has the wrong number of columns: received 2, expected 1"):
+        ck.kalman_bucy(sys, t, None, np.zeros((11, 2)), Q, R, np.eye(2), [0, 0])
+    with pytest.raises(ValueError, match=r"P0 must be positive definite"):
+        ck.kalman_bucy(sys, t, None, np.zeros((11, 1)), Q, R, np.zeros((2, 2)), [0, 0])
+    with pytest.raises(ValueError, match=r"x0 has the wrong length"):
+        ck.kalman_bucy(sys, t, None, np.zeros((11, 1)), Q, R, np.eye(2), [0, 0, 0])
+    with pytest.raises(ValueError, match=r"sys must be a continuous-time NonlinearSystem"):
+        ck.extended_kalman_filter(sys, t, None, np.zeros((11, 1)), Q, R, np.eye(2), [0, 0])
+    with pytest.raises(ValueError, match=r"sys must be a continuous-time StateSpace"):
+        ck.kalman_bucy(ck.models.pendulum(), t, None, np.zeros((11, 1)), Q, R, np.eye(2), [0, 0])
+    with pytest.raises(ValueError, match=r"y has the wrong number of columns: received 2, expected 1"):
+        ck.extended_kalman_filter(ck.models.pendulum(), t, None, np.zeros((11, 2)), Q,
+                                  np.eye(2), np.eye(2), [0, 0])
+    with pytest.raises(ValueError, match=r"dfdx must be a function"):
+        ck.extended_kalman_filter(ck.models.pendulum(), t, None, np.zeros((11, 1)), Q, R,
+                                  np.eye(2), [0, 0], dfdx=np.eye(2))
+
+
+def test_noise_bad_inputs():
+    with pytest.raises(ValueError, match=r"t must be uniformly spaced"):
+        ck.white_noise([0, 1, 3], 1.0)
+    with pytest.raises(ValueError, match=r"seed must be an int"):
+        ck.white_noise([0, 1, 2], 1.0, seed="x")
+    with pytest.raises(ValueError, match=r"R must be positive semidefinite"):
+        ck.simulate_with_noise(ck.StateSpace(A, B, C), [0, 1, 2], Q=Q, R=[[-1]])
