@@ -25,6 +25,8 @@ _MODULES = (
     # chapter 4: observability and observers
     # course tools: figure style
     "style",
+    # course tools: environment check (exercises stay the subpackage coursekit.exercises)
+    "environment_check",
 )
 
 __all__ = ["models"]

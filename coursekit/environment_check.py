@@ -1,0 +1,186 @@
+"""`check_environment()`: the first code cell of every notebook.
+
+It prints the versions of Python and of the packages the course needs, and
+warns, with the command that fixes it, about what would otherwise break later
+in the notebook: a package older than the supported lower bound (the bounds of
+``pyproject.toml``), or a JupyterLab without the ipywidgets front-end (the
+sliders would show as text such as ``VBox(children=...``).
+
+Versions are read from the installed package metadata, so the check imports
+none of the heavy libraries and runs in milliseconds.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+__all__ = ["check_environment", "EnvironmentReport", "MINIMUM_VERSIONS", "find_widget_frontend"]
+
+#: lower bounds of pyproject.toml (dependencies and the dev extra); a test keeps them in sync
+MINIMUM_VERSIONS = {
+    "numpy": "1.24",
+    "scipy": "1.10",
+    "sympy": "1.12",
+    "matplotlib": "3.7",
+    "ipywidgets": "8.0",
+    "jupyterlab": "4.0",
+}
+MINIMUM_PYTHON = (3, 10)
+
+#: packages that are reported when installed but not required in the kernel
+_OPTIONAL = ("jupyterlab", "ipykernel", "coursekit")
+
+#: the JupyterLab front-end of ipywidgets and the first major version that speaks ipywidgets 8
+_MANAGER = ("@jupyter-widgets", "jupyterlab-manager")
+_MANAGER_MIN_MAJOR = 5
+
+
+@dataclass
+class EnvironmentReport:
+    """What `check_environment` found: versions by package and the warnings (empty when fine)."""
+
+    python: str
+    versions: dict[str, str | None]
+    widget_frontend: str | None
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def ok(self) -> bool:
+        return not self.warnings
+
+    def __repr__(self) -> str:
+        state = "ok" if self.ok else f"{len(self.warnings)} warning(s)"
+        return f"<EnvironmentReport python {self.python}, {state}>"
+
+
+def _version_tuple(version: str) -> tuple[int, ...]:
+    """'1.26.4' -> (1, 26, 4); '2.0.0rc1' -> (2, 0, 0): enough to compare with a lower bound."""
+    parts = []
+    for piece in version.split(".")[:3]:
+        digits = ""
+        for ch in piece:
+            if not ch.isdigit():
+                break
+            digits += ch
+        if not digits:
+            break
+        parts.append(int(digits))
+    return tuple(parts)
+
+
+def _installed_version(dist: str) -> str | None:
+    from importlib.metadata import PackageNotFoundError, version
+    try:
+        return version(dist)
+    except PackageNotFoundError:
+        return None
+
+
+def _server_prefix() -> Path | None:
+    """The environment of the Jupyter server that started this kernel (Linux only), if any."""
+    exe = Path(f"/proc/{os.getppid()}/exe")
+    try:
+        cmdline = Path(f"/proc/{os.getppid()}/cmdline").read_bytes().decode(errors="replace")
+        target = exe.resolve()
+    except OSError:
+        return None
+    if "jupyter" not in cmdline and "lab" not in cmdline:
+        return None
+    return target.parent.parent
+
+
+def _labextension_dirs() -> list[Path]:
+    """Every directory JupyterLab reads prebuilt extensions from, as seen from here."""
+    dirs = []
+    try:
+        from jupyter_core.paths import jupyter_path
+        dirs += [Path(p) for p in jupyter_path("labextensions")]
+    except ImportError:
+        dirs.append(Path(sys.prefix) / "share" / "jupyter" / "labextensions")
+    server = _server_prefix()
+    if server is not None:
+        dirs.append(server / "share" / "jupyter" / "labextensions")
+    return dirs
+
+
+def find_widget_frontend(dirs: list[Path] | None = None) -> str | None:
+    """Version of the installed ``@jupyter-widgets/jupyterlab-manager`` labextension, or None."""
+    for base in dirs if dirs is not None else _labextension_dirs():
+        package = base.joinpath(*_MANAGER, "package.json")
+        if package.is_file():
+            try:
+                return str(json.loads(package.read_text(encoding="utf-8")).get("version", "unknown"))
+            except (OSError, ValueError):
+                return "unknown"
+    return None
+
+
+def _version_warnings(versions: dict[str, str | None]) -> list[str]:
+    warnings = []
+    for name, minimum in MINIMUM_VERSIONS.items():
+        have = versions.get(name)
+        if have is None:
+            if name not in _OPTIONAL:
+                warnings.append(f"{name} is not installed in this kernel's environment. "
+                                f'Fix: python -m pip install "{name}>={minimum}"')
+        elif _version_tuple(have) < _version_tuple(minimum):
+            warnings.append(f"{name} {have} is older than the supported {minimum}; some cells will fail. "
+                            f'Fix: python -m pip install -U "{name}>={minimum}", then restart the kernel.')
+    return warnings
+
+
+def _frontend_warnings(frontend: str | None, ipywidgets: str | None) -> list[str]:
+    if ipywidgets is None:
+        return []
+    fix = ('Fix: python -m pip install -U "ipywidgets>=8" "jupyterlab>=4" in the environment JupyterLab '
+           "runs from, then restart JupyterLab (not only the kernel) and reload the browser tab.")
+    if frontend is None:
+        return ["the ipywidgets front-end for JupyterLab (@jupyter-widgets/jupyterlab-manager) was not "
+                "found: sliders will show as text (VBox(...)) or only as a static figure. " + fix]
+    major = _version_tuple(frontend)[:1]
+    if major and major[0] < _MANAGER_MIN_MAJOR and _version_tuple(ipywidgets)[:1] >= (8,):
+        return [f"the JupyterLab widget front-end {frontend} is too old for ipywidgets {ipywidgets}: "
+                "widgets will show 'Error displaying widget'. " + fix]
+    return []
+
+
+def check_environment(*, show: bool = True) -> EnvironmentReport:
+    """Print Python's and the course packages' versions and warn about what will break.
+
+    Warns (with the command that fixes it) when a package is older than the
+    lower bound of ``pyproject.toml`` or missing, when Python is older than
+    3.10, and when the JupyterLab front-end of ipywidgets is not installed.
+    Returns an `EnvironmentReport`; ``show=False`` only builds it.
+    """
+    if not isinstance(show, bool):
+        raise ValueError(f"show must be True or False: received {show!r}.")
+    names = [*MINIMUM_VERSIONS, *(n for n in _OPTIONAL if n not in MINIMUM_VERSIONS)]
+    versions = {name: _installed_version(name) for name in names}
+    python = ".".join(map(str, sys.version_info[:3]))
+    warnings = []
+    if sys.version_info[:2] < MINIMUM_PYTHON:
+        warnings.append(f"Python {python} is older than 3.10: make a new environment with Python 3.10 "
+                        "or newer (see environment.md).")
+    warnings += _version_warnings(versions)
+    frontend = find_widget_frontend()
+    warnings += _frontend_warnings(frontend, versions.get("ipywidgets"))
+    report = EnvironmentReport(python=python, versions=versions, widget_frontend=frontend,
+                               warnings=warnings)
+    if show:
+        _print_report(report)
+    return report
+
+
+def _print_report(report: EnvironmentReport) -> None:
+    print(f"Python {report.python}")
+    for name, version in report.versions.items():
+        print(f"  {name:<11} {version or 'not installed'}")
+    print(f"  {'widgets UI':<11} {report.widget_frontend or 'not found'}  (JupyterLab front-end of ipywidgets)")
+    if report.ok:
+        print("Environment OK.")
+    for message in report.warnings:
+        print(f"WARNING: {message}")
