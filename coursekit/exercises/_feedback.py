@@ -146,6 +146,13 @@ def _entries(mask: np.ndarray) -> str:
     return ", ".join(f"({r + 1}, {c + 1})" for r, c in zip(rows, cols))
 
 
+def _at(mask: np.ndarray) -> str:
+    """ "the entry at (2, 1) has" / "the entries at 1, 3 have", for the feedback sentences."""
+    if mask.sum() == 1:
+        return f"the entry at {_entries(mask)} has"
+    return f"the entries at {_entries(mask)} have"
+
+
 def matrix_feedback(answer, expected, name: str, report: Report, *,
                     known_mistakes: Sequence[tuple[Any, str]] = (),
                     shape_hint: str = "", entry_hint: str = "", vector: bool = False) -> bool:
@@ -188,10 +195,10 @@ def matrix_feedback(answer, expected, name: str, report: Report, *,
     flipped = wrong & close(-arr, expected)
     other = wrong & ~flipped
     if flipped.any():
-        report.add(f"{name}: the entries at {_entries(flipped)} have the wrong sign. {entry_hint}".strip())
+        report.add(f"{name}: {_at(flipped)} the wrong sign. {entry_hint}".strip())
     if other.any():
-        report.add(f"{name}: the entries at {_entries(other)} are off (positions counted from 1). "
-                   f"{entry_hint}".strip())
+        report.add(f"{name}: {_at(other).replace(' has', ' is').replace(' have', ' are')} off "
+                   f"(counted from 1). {entry_hint}".strip())
     return False
 
 
