@@ -23,6 +23,7 @@ _MODULES = (
     # chapter 3: stability and state feedback
     "placement", "stability", "equilibria", "linearization", "controllers",
     # chapter 4: observability and observers
+    "observability", "observers", "kalman",
     # course tools: figure style
     "style",
     # course tools: environment check (exercises stay the subpackage coursekit.exercises)
