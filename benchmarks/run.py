@@ -1,0 +1,199 @@
+"""Benchmarks for coursekit: prints a markdown table of medians and ratios.
+
+Run from the repository root (with the `dev` extra installed):
+
+    python benchmarks/run.py            # everything
+    python benchmarks/run.py --quick    # fewer repetitions, no notebooks
+
+Each pair of competitors is timed in interleaved repetitions (a, b, a, b, ...)
+so that drift in the machine's speed affects both alike; the table reports
+medians. Nothing here is a test: targets are printed next to the measurements.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import inspect
+import json
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def interleaved(funcs: dict, repeat: int) -> dict:
+    """Median wall time of each function, calling them in turn `repeat` times."""
+    times = {name: [] for name in funcs}
+    for _ in range(repeat):
+        for name, func in funcs.items():
+            start = time.perf_counter()
+            func()
+            times[name].append(time.perf_counter() - start)
+    return {name: statistics.median(values) for name, values in times.items()}
+
+
+def ms(seconds: float) -> str:
+    return f"{1e3 * seconds:.2f} ms"
+
+
+def random_stable(n: int, seed: int):
+    rng = np.random.default_rng(seed)
+    A = rng.normal(size=(n, n))
+    A -= (np.abs(np.linalg.eigvals(A).real).max() + 0.5) * np.eye(n)
+    return A, rng.normal(size=(n, 1)), rng.normal(size=(1, n))
+
+
+def bench_simulate(repeat: int) -> list[str]:
+    import control
+    from scipy.signal import lsim
+    import coursekit as ck
+    rows = ["| states | coursekit `simulate` | python-control `forced_response` | scipy `lsim` "
+            "| ratio to forced_response (target <= 0.1) | max difference |",
+            "|---|---|---|---|---|---|"]
+    t = np.linspace(0, 10, 10_001)
+    for n in (4, 20):
+        A, B, C = random_stable(n, seed=n)
+        u = np.sin(t) + 0.1 * np.random.default_rng(0).normal(size=t.size)
+        x0 = np.ones(n)
+        ours, theirs = ck.StateSpace(A, B, C), control.ss(A, B, C, 0)
+        med = interleaved({
+            "ck": lambda: ck.simulate(ours, t, u, x0=x0),
+            "control": lambda: control.forced_response(theirs, t, u, X0=x0, return_x=True),
+            "lsim": lambda: lsim((A, B, C, 0), u, t, X0=x0),
+        }, repeat)
+        x_ck = ck.simulate(ours, t, u, x0=x0).x
+        x_ct = control.forced_response(theirs, t, u, X0=x0, return_x=True).states.T
+        x_ls = lsim((A, B, C, 0), u, t, X0=x0)[2]
+        diff = max(np.abs(x_ck - x_ct).max(), np.abs(x_ck - x_ls).max())
+        rows.append(f"| {n} | {ms(med['ck'])} | {ms(med['control'])} | {ms(med['lsim'])} "
+                    f"| {med['ck'] / med['control']:.3f} | {diff:.1e} |")
+    return rows
+
+
+def bench_place(repeat: int) -> list[str]:
+    import control
+    from scipy.signal import place_poles
+    import coursekit as ck
+    rows = ["| n | coursekit `place` | python-control `place` | scipy `place_poles` | max rel. K difference |",
+            "|---|---|---|---|---|"]
+    for n in (3, 6, 10):
+        rng = np.random.default_rng(n)
+        A, B = rng.normal(size=(n, n)), rng.normal(size=(n, 1))
+        poles = -np.linspace(1, 3, n)
+        med = interleaved({
+            "ck": lambda: ck.place(A, B, poles),
+            "control": lambda: control.place(A, B, poles),
+            "scipy": lambda: place_poles(A, B, poles),
+        }, repeat)
+        K = ck.place(A, B, poles)
+        K_ref = -np.atleast_2d(control.place(A, B, poles))
+        rel = np.abs(K - K_ref).max() / np.abs(K_ref).max()
+        rows.append(f"| {n} | {ms(med['ck'])} | {ms(med['control'])} | {ms(med['scipy'])} | {rel:.1e} |")
+    return rows
+
+
+def explorer_factories():
+    """Every ``*_explorer`` factory in coursekit.explorers.ch1..ch4 that exists."""
+    for chapter in range(1, 5):
+        try:
+            module = importlib.import_module(f"coursekit.explorers.ch{chapter}")
+        except ModuleNotFoundError:
+            continue
+        for name, func in inspect.getmembers(module, inspect.isfunction):
+            if name.endswith("_explorer") and func.__module__ == module.__name__:
+                yield f"ch{chapter}.{name}", func
+
+
+def bench_explorers(repeat: int) -> list[str]:
+    rows = ["| explorer | compute (target < 20 ms) | compute + redraw |", "|---|---|---|"]
+    for label, factory in explorer_factories():
+        explorer = factory()
+        med = interleaved({
+            "compute": lambda: explorer._compute(**explorer.params),
+            "refresh": explorer.refresh,
+        }, repeat)
+        rows.append(f"| {label} | {ms(med['compute'])} | {ms(med['refresh'])} |")
+    return rows
+
+
+def imports_only(nb: dict) -> dict:
+    """A copy of the notebook holding only its import lines (and %matplotlib)."""
+    lines = []
+    for cell in nb["cells"]:
+        if cell["cell_type"] != "code":
+            continue
+        for line in "".join(cell["source"]).splitlines():
+            stripped = line.strip()
+            if line == stripped and (stripped.startswith(("import ", "from ", "%matplotlib"))):
+                lines.append(stripped)
+    baseline = dict(nb, cells=[{"cell_type": "code", "metadata": {}, "outputs": [],
+                                "execution_count": None, "source": "\n".join(dict.fromkeys(lines))}])
+    return baseline
+
+
+def run_notebook(nb: dict) -> None:
+    import nbformat
+    from nbclient import NotebookClient
+    client = NotebookClient(nbformat.from_dict(nb), timeout=600, kernel_name="python3",
+                            resources={"metadata": {"path": str(ROOT / "notebooks")}})
+    client.execute()
+
+
+def bench_notebooks(repeat: int) -> list[str]:
+    rows = ["| notebook | full run | imports only | ratio (target <= 2) |", "|---|---|---|---|"]
+    for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        nb = json.loads(path.read_text(encoding="utf-8"))
+        med = interleaved({"full": lambda: run_notebook(nb),
+                           "imports": lambda: run_notebook(imports_only(nb))}, repeat)
+        rows.append(f"| {path.name} | {med['full']:.1f} s | {med['imports']:.1f} s "
+                    f"| {med['full'] / med['imports']:.2f} |")
+    return rows
+
+
+def bench_import(repeat: int) -> list[str]:
+    code = ("import time; t = time.perf_counter(); import {mod}; "
+            "print(time.perf_counter() - t)")
+
+    def measure(mod):
+        out = subprocess.run([sys.executable, "-c", code.format(mod=mod)], capture_output=True,
+                             text=True, check=True, cwd=ROOT)
+        return float(out.stdout)
+
+    samples = {"numpy": [], "coursekit": []}
+    for _ in range(repeat):
+        for mod in samples:
+            samples[mod].append(measure(mod))
+    med = {mod: statistics.median(v) for mod, v in samples.items()}
+    return ["| `import` in a fresh interpreter | median |", "|---|---|",
+            f"| numpy | {ms(med['numpy'])} |",
+            f"| coursekit (includes numpy; target < 500 ms) | {ms(med['coursekit'])} |"]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--quick", action="store_true", help="fewer repetitions, skip notebooks")
+    args = parser.parse_args()
+    repeat = 5 if args.quick else 21
+    sections = [
+        ("simulate: 10 001 samples, one input", bench_simulate, repeat),
+        ("place: single input, poles -1..-3", bench_place, repeat),
+        ("explorers", bench_explorers, repeat),
+        ("import time", bench_import, 5 if args.quick else 11),
+    ]
+    if not args.quick:
+        sections.append(("notebooks (fresh kernel each run)", bench_notebooks, 3))
+    print(f"coursekit benchmarks, Python {sys.version.split()[0]}, numpy {np.__version__}\n")
+    for title, func, reps in sections:
+        print(f"### {title} (median of {reps})\n")
+        print("\n".join(func(reps)))
+        print()
+
+
+if __name__ == "__main__":
+    main()
