@@ -1,0 +1,258 @@
+"""Explorers of chapter 3: pole placement, the upright pendulum, integral action.
+
+Each explorer is a pure ``*_compute`` function (numbers only, unit-tested)
+and a ``*_explorer()`` factory that wires it to sliders.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import models
+from .._validation import as_scalar
+from ..controllers import PendulumLinearizingController, StateFeedback, integral_augment, integral_closed_loop
+from ..linearization import linearize
+from ..placement import place
+from ..simulation import simulate
+from ..systems import StateSpace
+from ._base import Explorer, slider
+
+__all__ = [
+    "pair_poles",
+    "pole_placement_compute",
+    "pole_placement_explorer",
+    "upright_pendulum_compute",
+    "upright_pendulum_explorer",
+    "integral_action_compute",
+    "integral_action_explorer",
+]
+
+#: plant of the pole-placement explorer: (3.22) driven through its first input only
+PLACEMENT_A = np.array([[2.0, 0.0, 0.0], [1.0, -1.0, 2.0], [0.0, 2.0, -1.0]])
+PLACEMENT_B = np.array([[1.0], [0.0], [0.0]])
+
+#: plant of the integral-action explorer: the CCF (3.27) with a0 = 6, a1 = -5
+INTEGRAL_A = np.array([[0.0, 1.0], [-6.0, 5.0]])
+INTEGRAL_B = np.array([[0.0], [1.0]])
+
+
+def pair_poles(wn: float, zeta: float) -> np.ndarray:
+    """The two roots of s^2 + 2 zeta wn s + wn^2 (complex pair when zeta < 1)."""
+    wn, zeta = as_scalar(wn, "wn", positive=True), as_scalar(zeta, "zeta", positive=True)
+    if zeta < 1:
+        wd = wn * np.sqrt(1 - zeta**2)
+        return np.array([-zeta * wn + 1j * wd, -zeta * wn - 1j * wd])
+    root = wn * np.sqrt(zeta**2 - 1)
+    return np.array([-zeta * wn + root, -zeta * wn - root], dtype=complex)
+
+
+def _gain_text(K) -> str:
+    return "K = [" + ", ".join(f"{k:.3g}" for k in np.ravel(K)) + "]"
+
+
+def pole_placement_compute(wn: float = 2.0, zeta: float = 0.7, p3: float = -3.0,
+                           t_end: float = 6.0, samples: int = 1000) -> dict:
+    """Place a pole pair (wn, zeta) and a real pole p3 for the plant (3.22) with input u1.
+
+    K = place(A, B, poles) (3.46)-(3.47); the closed loop A + B K (3.21) is
+    simulated exactly from x0 = [1, 0, 0]. Returns ``t``, ``x`` (N, 3),
+    ``u`` (N,) = K x, ``K``, ``poles`` (requested), ``achieved``
+    (eig(A + B K)), ``open_loop`` (eig A) and ``max_u`` = max |u|.
+    """
+    p3 = as_scalar(p3, "p3")
+    poles = np.concatenate([pair_poles(wn, zeta), [p3]])
+    K = place(PLACEMENT_A, PLACEMENT_B, poles)
+    A_cl = PLACEMENT_A + PLACEMENT_B @ K
+    t = np.linspace(0.0, as_scalar(t_end, "t_end", positive=True), int(samples))
+    x = simulate(StateSpace(A_cl), t, x0=[1.0, 0.0, 0.0]).x
+    u = x @ K[0]
+    return dict(t=t, x=x, u=u, K=K, poles=poles, achieved=np.linalg.eigvals(A_cl),
+                open_loop=np.linalg.eigvals(PLACEMENT_A), max_u=float(np.abs(u).max()))
+
+
+def pole_placement_explorer() -> Explorer:
+    """Sliders for a pole pair (wn, zeta) and a real pole: K, pole plot, x(t) and u(t)."""
+    def draw(fig):
+        ax_p, ax_x, ax_u = fig.subplots(1, 3, width_ratios=[1, 1.3, 1.3])
+        ax_p.axvspan(-1e3, 0, color="tab:green", alpha=0.12, label="stable (Re < 0)")
+        ol, = ax_p.plot([], [], "x", color="C3", ms=10, mew=2, label="open loop eig(A)")
+        cl, = ax_p.plot([], [], "o", color="C0", ms=10, mew=2, fillstyle="none",
+                        label="closed loop eig(A + B K)")
+        ax_p.axhline(0, color="0.5", lw=0.8)
+        ax_p.axvline(0, color="0.5", lw=0.8)
+        ax_p.set(xlim=(-12, 4), ylim=(-8, 8), xlabel="real part [1/s]", ylabel="imaginary part [rad/s]",
+                 title="poles")
+        ax_p.legend(loc="lower left", fontsize="small")
+        xs = [ax_x.plot([], [], label=f"x{i + 1}")[0] for i in range(3)]
+        ax_x.set(xlabel="time t [s]", ylabel="state x (dimensionless)")
+        ax_x.legend(loc="upper right")
+        u, = ax_u.plot([], [], color="C4", label="u = K x")
+        ax_u.set(xlabel="time t [s]", ylabel="control effort u", title="control effort u(t)")
+        ax_u.legend(loc="lower right")
+        for ax in (ax_p, ax_x, ax_u):
+            ax.grid(True, alpha=0.4)
+        return dict(ax_p=ax_p, ax_x=ax_x, ax_u=ax_u, ol=ol, cl=cl, xs=xs, u=u)
+
+    def update(h, r):
+        h["ol"].set_data(r["open_loop"].real, r["open_loop"].imag)
+        h["cl"].set_data(r["achieved"].real, r["achieved"].imag)
+        h["ax_p"].set_xlim(min(-12.0, 1.15 * r["achieved"].real.min()), 4.0)
+        for i, line in enumerate(h["xs"]):
+            line.set_data(r["t"], r["x"][:, i])
+        h["u"].set_data(r["t"], r["u"])
+        for ax in (h["ax_x"], h["ax_u"]):
+            ax.relim()
+            ax.autoscale_view()
+        h["ax_x"].set_title(f"response from x0 = [1, 0, 0]\n{_gain_text(r['K'])}")
+        h["ax_u"].set_title(f"control effort u(t), max |u| = {r['max_u']:.3g}")
+
+    return Explorer(
+        title="Pole placement (3.46)-(3.47) for the plant (3.22) driven by u1 only",
+        controls=dict(wn=slider(2.0, 0.5, 6.0, 0.25, "pair: natural frequency wn [rad/s]"),
+                      zeta=slider(0.7, 0.1, 2.0, 0.05, "pair: damping ratio zeta"),
+                      p3=slider(-3.0, -10.0, -0.5, 0.25, "real pole p3 [1/s]")),
+        compute=pole_placement_compute, draw=draw, update=update, figsize=(13, 4.5))
+
+
+def _saturated(ctrl, u_max: float):
+    """The controller with its torque clipped to [-u_max, u_max] (an actuator limit)."""
+    return lambda t, x: np.clip(ctrl(t, x), -u_max, u_max)
+
+
+def upright_pendulum_compute(theta0_deg: float = 30.0, pole: float = -2.0, u_max: float = 50.0,
+                             t_end: float = 5.0, samples: int = 500) -> dict:
+    """Hold the pendulum (m = l = 1, g = 9.81, no damping) upright, theta* = pi.
+
+    Both controllers place the poles at ``[pole, pole - 1]``: the linear
+    law u = K (x - x*) + u* (3.92) with K from the linearization (3.74),
+    and the feedback-linearizing law (3.154) measured from theta = pi. Both
+    torques are clipped to |u| <= `u_max` [N m] (a motor limit; the notes
+    have none). Start: `theta0_deg` away from upright, at rest. Returns
+    ``t``, the deviations from upright ``dev_linear`` and ``dev_fl`` [deg],
+    the torques ``u_linear`` and ``u_fl`` [N m], ``K`` and booleans
+    ``linear_ok`` / ``fl_ok`` (ends within 1 degree of upright, any turn).
+    """
+    theta0 = np.deg2rad(as_scalar(theta0_deg, "theta0_deg"))
+    pole = as_scalar(pole, "pole")
+    u_max = as_scalar(u_max, "u_max", positive=True)
+    if pole >= 0:
+        raise ValueError(f"pole must be negative (a stable closed loop): received {pole!r}.")
+    P = models.pendulum()
+    x_eq, u_eq = np.array([np.pi, 0.0]), np.array([0.0])
+    poles = [pole, pole - 1.0]
+    A, B = linearize(P, x_eq, u_eq)
+    K = place(A, B, poles)
+    controllers = dict(linear=StateFeedback(K, x_eq, u_eq),
+                       fl=PendulumLinearizingController(poles, theta_ref=np.pi))
+    t = np.linspace(0.0, as_scalar(t_end, "t_end", positive=True), int(samples))
+    out = dict(t=t, K=K, theta0_deg=float(np.rad2deg(theta0)), u_max=u_max)
+    for name, ctrl in controllers.items():
+        res = simulate(P, t, u=_saturated(ctrl, u_max), x0=[np.pi - theta0, 0.0], rtol=1e-7, atol=1e-9)
+        dev = np.rad2deg(res.x[:, 0] - np.pi)
+        out[f"dev_{name}"], out[f"u_{name}"] = dev, res.u[:, 0]
+        wrapped = (dev[-1] + 180.0) % 360.0 - 180.0
+        out[f"{name}_ok"] = bool(abs(wrapped) < 1.0 and abs(res.x[-1, 1]) < 0.1)
+    return out
+
+
+def upright_pendulum_explorer() -> Explorer:
+    """Sliders for the initial angle and the pole speed: linear vs feedback-linearizing control."""
+    def draw(fig):
+        ax_th, ax_u = fig.subplots(1, 2)
+        lin, = ax_th.plot([], [], color="C0", label="linear u = K(x - x*) (3.92)")
+        fl, = ax_th.plot([], [], color="C1", ls="--", label="feedback linearizing (3.154)")
+        ax_th.axhline(0, color="0.5", lw=0.8)
+        ax_th.set(xlabel="time t [s]", ylabel="angle from upright theta - pi [deg]")
+        ax_th.legend(loc="lower right")
+        ulin, = ax_u.plot([], [], color="C0", label="linear")
+        ufl, = ax_u.plot([], [], color="C1", ls="--", label="feedback linearizing")
+        ax_u.set(xlabel="time t [s]", ylabel="torque u [N m]", title="control torque")
+        ax_u.legend(loc="upper right")
+        for ax in (ax_th, ax_u):
+            ax.grid(True, alpha=0.4)
+        return dict(ax_th=ax_th, ax_u=ax_u, lin=lin, fl=fl, ulin=ulin, ufl=ufl)
+
+    def update(h, r):
+        h["lin"].set_data(r["t"], r["dev_linear"])
+        h["fl"].set_data(r["t"], r["dev_fl"])
+        h["ulin"].set_data(r["t"], r["u_linear"])
+        h["ufl"].set_data(r["t"], r["u_fl"])
+        for ax in (h["ax_th"], h["ax_u"]):
+            ax.relim()
+            ax.autoscale_view()
+        verdict = lambda ok: "upright" if ok else "NOT upright"  # noqa: E731
+        h["ax_th"].set_title(f"start {r['theta0_deg']:g} deg from upright, |u| <= {r['u_max']:g} N m\n"
+                             f"linear: {verdict(r['linear_ok'])}, feedback linearizing: {verdict(r['fl_ok'])}")
+
+    return Explorer(
+        title="Upright pendulum (m = l = 1, g = 9.81): linear feedback vs feedback linearization",
+        controls=dict(theta0_deg=slider(30.0, -180.0, 180.0, 5.0, "initial angle from upright [deg]"),
+                      pole=slider(-2.0, -6.0, -0.5, 0.25, "closed-loop poles [pole, pole - 1]"),
+                      u_max=slider(50.0, 2.0, 60.0, 1.0, "torque limit |u| <= [N m]")),
+        compute=upright_pendulum_compute, draw=draw, update=update, figsize=(12, 4.5))
+
+
+def integral_action_compute(d: float = 1.0, integral_pole: float = -1.0, t_end: float = 12.0,
+                            samples: int = 1200) -> dict:
+    """Constant input disturbance d from t = 1 s on the CCF (3.27) (a0 = 6, a1 = -5).
+
+    Plain state feedback u = K x places eig(A + B K) at -1, -2 (3.31)-(3.37) and
+    keeps the offset (3.109); with an integrator on x1 the augmented poles
+    are -1, -2 and `integral_pole` and the offset goes to zero. Returns
+    ``t``, ``y_plain``, ``y_int`` (= x1), ``u_plain``, ``u_int``, the gains
+    ``K`` and ``K_E`` (= [k_I, k1, k2]) and the predicted ``offset`` of plain feedback.
+    """
+    d = as_scalar(d, "d")
+    integral_pole = as_scalar(integral_pole, "integral_pole")
+    if integral_pole >= 0:
+        raise ValueError(f"integral_pole must be negative: received {integral_pole!r}.")
+    A, B = INTEGRAL_A, INTEGRAL_B
+    K = place(A, B, [-1.0, -2.0])
+    A_E, B_E = integral_augment(A, B)
+    K_E = place(A_E, B_E, [-1.0, -2.0, integral_pole])
+    t = np.linspace(0.0, as_scalar(t_end, "t_end", positive=True), int(samples))
+    dist = np.where(t >= 1.0, d, 0.0)
+    plain = simulate(StateSpace(A + B @ K, B), t, dist.reshape(-1, 1))
+    loop = integral_closed_loop(A, B, K_E)
+    integ = simulate(loop, t, np.column_stack([dist, np.zeros_like(t)]))
+    # (3.109) for the state vector: x_inf = -(A + B K)^-1 B d
+    offset = float(-np.linalg.solve(A + B @ K, B[:, 0] * d)[0])
+    return dict(t=t, y_plain=plain.x[:, 0], y_int=integ.y[:, 0], u_plain=plain.x @ K[0],
+                u_int=integ.x @ K_E[0], K=K, K_E=K_E, offset=offset, d=d)
+
+
+def integral_action_explorer() -> Explorer:
+    """Sliders for the disturbance size and the integral pole: offset with and without integrator."""
+    def draw(fig):
+        ax_y, ax_u = fig.subplots(1, 2)
+        plain, = ax_y.plot([], [], color="C0", label="u = K x (offset 3.109)")
+        integ, = ax_y.plot([], [], color="C2", label="with integral action (3.117)")
+        off = ax_y.axhline(0, color="C0", ls=":", label="predicted offset")
+        ax_y.axvline(1.0, color="0.5", ls="--", lw=0.8)
+        ax_y.set(xlabel="time t [s]", ylabel="output y = x1")
+        ax_y.legend(loc="center right")
+        uplain, = ax_u.plot([], [], color="C0", label="u = K x")
+        uint, = ax_u.plot([], [], color="C2", label="u = K x + k_I int x1")
+        ax_u.set(xlabel="time t [s]", ylabel="control input u", title="control input (integral action ends at u = -d)")
+        ax_u.legend(loc="upper right")
+        for ax in (ax_y, ax_u):
+            ax.grid(True, alpha=0.4)
+        return dict(ax_y=ax_y, ax_u=ax_u, plain=plain, integ=integ, off=off, uplain=uplain, uint=uint)
+
+    def update(h, r):
+        h["plain"].set_data(r["t"], r["y_plain"])
+        h["integ"].set_data(r["t"], r["y_int"])
+        h["off"].set_ydata([r["offset"], r["offset"]])
+        h["uplain"].set_data(r["t"], r["u_plain"])
+        h["uint"].set_data(r["t"], r["u_int"])
+        for ax in (h["ax_y"], h["ax_u"]):
+            ax.relim()
+            ax.autoscale_view()
+        h["ax_y"].set_title(f"step disturbance d = {r['d']:g} at t = 1 s; "
+                            f"K_E = [{', '.join(f'{k:.3g}' for k in r['K_E'][0])}]")
+
+    return Explorer(
+        title="Integral action (3.110)-(3.120) on the CCF (3.27), a0 = 6, a1 = -5",
+        controls=dict(d=slider(1.0, -3.0, 3.0, 0.25, "disturbance d"),
+                      integral_pole=slider(-1.0, -6.0, -0.2, 0.1, "integral pole [1/s]")),
+        compute=integral_action_compute, draw=draw, update=update, figsize=(12, 4.5))

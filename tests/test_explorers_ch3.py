@@ -1,0 +1,69 @@
+"""Chapter 3 explorers: the pure compute functions and the widget factories."""
+
+import numpy as np
+import pytest
+
+import coursekit as ck
+from conftest import sorted_eig
+from coursekit.explorers import ch3
+
+
+def test_pair_poles():
+    np.testing.assert_allclose(ch3.pair_poles(2.0, 0.6), [-1.2 + 1.6j, -1.2 - 1.6j])
+    np.testing.assert_allclose(ch3.pair_poles(1.0, 1.25), [-0.5, -2.0])
+    with pytest.raises(ValueError, match="zeta must be positive"):
+        ch3.pair_poles(1.0, 0.0)
+
+
+@pytest.mark.parametrize("wn, zeta, p3", [(2.0, 0.7, -3.0), (1.0, 1.0, -0.5), (5.0, 0.2, -8.0)])
+def test_pole_placement_compute_places_the_poles(wn, zeta, p3):
+    r = ch3.pole_placement_compute(wn=wn, zeta=zeta, p3=p3)
+    np.testing.assert_allclose(sorted_eig(r["achieved"]), sorted_eig(r["poles"]), atol=1e-6)
+    np.testing.assert_allclose(r["K"], ck.place(ch3.PLACEMENT_A, ch3.PLACEMENT_B, r["poles"]))
+    np.testing.assert_allclose(r["u"], r["x"] @ r["K"][0])
+    from scipy.linalg import expm
+    A_cl = ch3.PLACEMENT_A + ch3.PLACEMENT_B @ r["K"]
+    np.testing.assert_allclose(r["x"][-1], expm(A_cl * r["t"][-1]) @ [1, 0, 0], atol=1e-8)
+    assert r["max_u"] == pytest.approx(np.abs(r["u"]).max())
+
+
+def test_upright_pendulum_compute_both_controllers():
+    r = ch3.upright_pendulum_compute(theta0_deg=30.0)
+    assert r["linear_ok"] and r["fl_ok"]
+    assert r["dev_linear"][0] == pytest.approx(-30.0)
+    # the feedback-linearized loop is exactly linear: e'' = -6 e - 5 e' from e(0) = -30 deg
+    t = r["t"]
+    exact = -30.0 * (3 * np.exp(-2 * t) - 2 * np.exp(-3 * t))
+    np.testing.assert_allclose(r["dev_fl"], exact, atol=1e-4)
+    # a tight torque limit loses the pendulum from 120 degrees
+    r = ch3.upright_pendulum_compute(theta0_deg=120.0, u_max=3.0)
+    assert not r["fl_ok"] and np.abs(r["u_linear"]).max() <= 3.0 + 1e-12
+    with pytest.raises(ValueError, match="pole must be negative"):
+        ch3.upright_pendulum_compute(pole=1.0)
+
+
+def test_integral_action_compute_removes_the_offset():
+    r = ch3.integral_action_compute(d=2.0, integral_pole=-1.5, t_end=20.0)
+    assert r["offset"] == pytest.approx(1.0)                   # -(A + B K)^-1 B d, first entry
+    assert r["y_plain"][-1] == pytest.approx(1.0, abs=1e-5)
+    assert abs(r["y_int"][-1]) < 1e-5
+    assert r["u_int"][-1] == pytest.approx(-2.0, abs=1e-5)      # it ends by cancelling d
+    A_E, B_E = ck.integral_augment(ch3.INTEGRAL_A, ch3.INTEGRAL_B)
+    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A_E + B_E @ r["K_E"])), [-2, -1.5, -1], atol=1e-8)
+    with pytest.raises(ValueError, match="integral_pole must be negative"):
+        ch3.integral_action_compute(integral_pole=0.5)
+
+
+@pytest.mark.parametrize("factory", [ch3.pole_placement_explorer, ch3.upright_pendulum_explorer,
+                                     ch3.integral_action_explorer])
+def test_explorers_build_label_and_refresh(factory):
+    e = factory()
+    assert e.fig.axes and e._png.startswith(b"\x89PNG")
+    for ax in e.fig.axes:
+        assert ax.get_xlabel() and ax.get_ylabel() and ax.get_title()
+    name, widget = next(iter(e.controls.items()))
+    before = e.result
+    widget.value = widget.max
+    e.refresh()
+    assert e.params[name] == widget.max and e.result is not before
+    assert widget.continuous_update is False
