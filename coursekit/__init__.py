@@ -19,7 +19,7 @@ _MODULES = (
     # chapter 1: representations
     "systems", "simulation", "realization", "interconnect", "plotting",
     # chapter 2: controllability and open-loop control
-    "controllability",
+    "controllability", "trajectory", "flatness", "symbolic",
     # chapter 3: stability and state feedback
     "placement", "stability", "equilibria", "linearization", "controllers",
     # chapter 4: observability and observers

@@ -1,0 +1,176 @@
+"""Explorers of chapter 2: a rest-to-rest trajectory planner and a robot path planner.
+
+Each explorer is a pure ``*_compute`` function (numbers only, unit-tested)
+and a ``*_explorer()`` factory that wires it to sliders.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .. import models
+from .._validation import as_scalar
+from ..flatness import plan_robot
+from ..simulation import simulate
+from ..trajectory import feedforward, poly_trajectory
+from ._base import Explorer, int_slider, slider
+
+__all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robot_planner_explorer"]
+
+#: the plant of the trajectory planner: mass-spring-damper (2.27) [kg, N s/m, N/m]
+PLANNER_PLANT = dict(m=1.0, d=0.5, k=2.0)
+
+
+def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0, r: int = 2,
+                    samples: int = 1000) -> dict:
+    """Rest-to-rest move of the mass-spring-damper from y = 0 to y = `target` [m] in `T` [s].
+
+    Plans the polynomial of degree 2r - 1 with y_d(0) = 0, y_d(T) = target and
+    derivatives 1..r-1 zero at both ends (r = 2: the cubic (2.40); r = 3 also
+    makes the acceleration, hence u_d, continuous at 0 and T), computes u_d = k y_d + d y_d' + m y_d'' (2.30), i.e. (2.25)
+    with a = [k/m, d/m], b = 1/m, and applies it for 2 T to the plant whose
+    mass is off by `mass_error` percent. Returns ``t, yd, ud, y`` (time-major
+    arrays), ``end_error`` = |y(T) - target| and the parameters.
+    """
+    T = as_scalar(T, "T", positive=True)
+    target = as_scalar(target, "target")
+    mass_error = as_scalar(mass_error, "mass_error")
+    m, d, k = PLANNER_PLANT["m"], PLANNER_PLANT["d"], PLANNER_PLANT["k"]
+    r = int(as_scalar(r, "r", positive=True, integer=True))
+    if r < 2:
+        raise ValueError(f"r must be >= 2: received {r}; the two states y, y' need two boundary "
+                         "conditions at each end (2.31).")
+    zeros = [0.0] * (r - 1)
+    traj = poly_trajectory(T, [0.0] + zeros, [target] + zeros)
+    ud = feedforward([k / m, d / m], 1.0 / m, traj)
+    t = np.linspace(0.0, 2.0 * T, samples)
+    # after T the plan holds y_d = target, so u_d = k * target
+    u = np.where(t <= T, ud(np.minimum(t, T)), k * target)
+    plant = models.mass_spring_damper(m=m * (1.0 + mass_error / 100.0), d=d, k=k)
+    y = simulate(plant, t, u=u.reshape(-1, 1)).x[:, 0]
+    yd = np.where(t <= T, traj(np.minimum(t, T)), target)
+    i_T = int(np.searchsorted(t, T))
+    return dict(t=t, yd=yd, ud=u, y=y, end_error=float(abs(y[i_T] - target)), T=T, target=target,
+                mass_error=mass_error, r=r)
+
+
+def planner_explorer() -> Explorer:
+    """Sliders for the horizon T, the target and a mass error: y_d, u_d and the simulated y."""
+    def draw(fig):
+        ax_y, ax_u = fig.subplots(2, 1, sharex=True)
+        yd, = ax_y.plot([], [], "k--", label="planned y_d")
+        y, = ax_y.plot([], [], color="C0", label="simulated y")
+        ax_y.set_ylabel("position y [m]")
+        ax_y.legend(loc="lower right")
+        ax_y.grid(True, alpha=0.4)
+        ud, = ax_u.plot([], [], color="C1", label="u_d (2.30), held at k y(T) after T")
+        ax_u.set_ylabel("force u [N]")
+        ax_u.set_xlabel("time t [s]")
+        ax_u.legend(loc="upper right")
+        ax_u.grid(True, alpha=0.4)
+        marks = [ax.axvline(0, color="0.5", linestyle=":") for ax in (ax_y, ax_u)]
+        return dict(ax_y=ax_y, ax_u=ax_u, yd=yd, y=y, ud=ud, marks=marks)
+
+    def update(h, r):
+        h["yd"].set_data(r["t"], r["yd"])
+        h["y"].set_data(r["t"], r["y"])
+        h["ud"].set_data(r["t"], r["ud"])
+        for line in h["marks"]:
+            line.set_xdata([r["T"], r["T"]])
+        for ax in (h["ax_y"], h["ax_u"]):
+            ax.relim()
+            ax.autoscale_view()
+        h["ax_y"].set_title(f"degree {2 * r['r'] - 1} move to {r['target']:g} m in T = {r['T']:g} s, mass error "
+                            f"{r['mass_error']:g} %: |y(T) - target| = {r['end_error']:.2g} m")
+
+    return Explorer(
+        title="Trajectory planner (2.30), (2.40): mass-spring-damper m = 1 kg, d = 0.5 N s/m, k = 2 N/m",
+        controls=dict(T=slider(3.0, 0.5, 10.0, 0.1, "horizon T [s]"),
+                      target=slider(1.0, -2.0, 2.0, 0.1, "target y(T) [m]"),
+                      mass_error=slider(0.0, -30.0, 30.0, 1.0, "mass error [%]"),
+                      r=int_slider(2, 2, 4, "boundary conditions r")),
+        compute=planner_compute, draw=draw, update=update, figsize=(9, 6))
+
+
+def robot_planner_compute(x_T: float = 4.0, y_T: float = 2.0, heading_deg: float = 90.0,
+                          T: float = 6.0, speed: float = 1.0, samples: int = 500) -> dict:
+    """Flat plan for the two-wheeled robot (2.94)-(2.102) from (0, 0, 0) to (x_T, y_T, heading).
+
+    Uses `plan_robot` (cubic F = (x1, x2) with speed `speed` [m/s] at both
+    ends) and drives the plan open loop on the nonlinear model (1.10), with
+    the input u_d = psi_u sampled at the `samples` times and linear in between.
+    Returns the planned ``path`` and the ``driven`` path (shape (N, 3):
+    x1, x2, theta), the inputs ``u`` (N, 2), ``end_error`` (distance [m]
+    between driven and target position), ``min_speed`` and ``message``.
+    When the plan is singular (zero speed), the paths are empty and
+    ``message`` says why.
+    """
+    x_T, y_T = as_scalar(x_T, "x_T"), as_scalar(y_T, "y_T")
+    heading = np.deg2rad(as_scalar(heading_deg, "heading_deg"))
+    T = as_scalar(T, "T", positive=True)
+    speed = as_scalar(speed, "speed")
+    t = np.linspace(0.0, T, samples)
+    target = np.array([x_T, y_T, heading])
+    empty = np.empty((0, 3))
+    try:
+        plan = plan_robot([0.0, 0.0, 0.0], target, T, speed=speed)
+    except ValueError as err:
+        return dict(t=t, path=empty, driven=empty, u=np.empty((0, 2)), end_error=float("nan"),
+                    min_speed=0.0, target=target, T=T, message=str(err).split(":")[0])
+    u = plan.u(t)
+    # the input samples, linear in between (as a digital controller replays them), drive the model
+    driven = simulate(models.two_wheeled_robot(), t, u=u, x0=plan.x0, rtol=1e-6, atol=1e-9).x
+    end_error = float(np.hypot(*(driven[-1, :2] - target[:2])))
+    return dict(t=t, path=plan.x(t), driven=driven, u=u, end_error=end_error,
+                min_speed=plan.min_speed, target=target, T=T,
+                message=f"end error {end_error:.1e} m, min speed {plan.min_speed:.2f} m/s")
+
+
+def robot_planner_explorer() -> Explorer:
+    """Sliders for the target pose: planned path (flatness) and the path the robot drives."""
+    def draw(fig):
+        ax, ax_u = fig.subplots(1, 2, width_ratios=[1.3, 1])
+        path, = ax.plot([], [], "k--", label="planned path F_d")
+        driven, = ax.plot([], [], color="C0", alpha=0.8, label="driven (model 1.10)")
+        goal = ax.quiver([0.0], [0.0], [1.0], [0.0], color="C3", scale=12, label="target pose")
+        ax.plot([0], [0], "ko")
+        ax.set_xlabel("x1 [m]")
+        ax.set_ylabel("x2 [m]")
+        ax.set_aspect("equal", adjustable="datalim")
+        ax.legend(loc="upper left")
+        ax.grid(True, alpha=0.4)
+        u1, = ax_u.plot([], [], label="speed u1 [m/s]")
+        u2, = ax_u.plot([], [], label="turn rate u2 [rad/s]")
+        ax_u.set_xlabel("time t [s]")
+        ax_u.set_ylabel("u1 [m/s], u2 [rad/s]")
+        ax_u.set_title("inputs psi_u (2.102)")
+        ax_u.legend(loc="upper right")
+        ax_u.grid(True, alpha=0.4)
+        return dict(ax=ax, ax_u=ax_u, path=path, driven=driven, goal=goal, u1=u1, u2=u2)
+
+    def update(h, r):
+        h["path"].set_data(r["path"][:, 0], r["path"][:, 1])
+        h["driven"].set_data(r["driven"][:, 0], r["driven"][:, 1])
+        tx, ty, th = r["target"]
+        h["goal"].set_offsets([[tx, ty]])
+        h["goal"].set_UVC([np.cos(th)], [np.sin(th)])
+        tu = r["t"][:r["u"].shape[0]]
+        h["u1"].set_data(tu, r["u"][:, 0])
+        h["u2"].set_data(tu, r["u"][:, 1])
+        for ax in (h["ax"], h["ax_u"]):
+            ax.relim()
+        # the target arrow is not part of relim: include start and target explicitly
+        h["ax"].update_datalim([[0.0, 0.0], [tx, ty]])
+        for ax in (h["ax"], h["ax_u"]):
+            ax.autoscale_view()
+        h["ax"].set_title(f"two-wheeled robot to ({tx:g} m, {ty:g} m, {np.rad2deg(th):g} deg) "
+                          f"in {r['T']:g} s\n{r['message']}")
+
+    return Explorer(
+        title="Two-wheeled robot planner (2.94)-(2.102): flat outputs F = (x1, x2)",
+        controls=dict(x_T=slider(4.0, -6.0, 6.0, 0.5, "target x1 [m]"),
+                      y_T=slider(2.0, -6.0, 6.0, 0.5, "target x2 [m]"),
+                      heading_deg=slider(90.0, -180.0, 180.0, 15.0, "target heading [deg]"),
+                      T=slider(6.0, 1.0, 20.0, 0.5, "horizon T [s]"),
+                      speed=slider(1.0, -2.0, 2.0, 0.1, "end speed [m/s]")),
+        compute=robot_planner_compute, draw=draw, update=update, figsize=(11, 5))

@@ -1,0 +1,406 @@
+"""Flatness (section 2.4): state and input as functions of a flat output F.
+
+A `FlatSystem` bundles, for one system, the flat output F = phi(x) and the
+two maps of (2.88)-(2.89)::
+
+    x = psi_x(F, F', ..., F^(n-1)),    u = psi_u(F, F', ..., F^(n)).
+
+Both maps take ``derivs = [F, F', F'', ...]``: a list whose k-th entry is the
+k-th derivative of F, an array with one entry per flat output (shape (p,))
+at one time or shape (N, p) at N times; with one flat output a number or an
+(N,) array (N > 1) is accepted too. They return x of shape (n,) or (N, n) and u of
+shape (m,) or (N, m).
+
+The systems of the notes:
+
+* `linear_flatness(A, B)`: F = T_1 x (2.74)-(2.87);
+* `pendulum_flatness(...)`: F = theta (2.90)-(2.92);
+* `two_wheeled_flatness()`: F = (x1, x2) (2.94)-(2.102);
+* `car_like_flatness(L)`: F = (x1, x2), the exercise at the end of 2.4.
+
+`plan_flat_output` plans polynomial F_d (the nonlinear open-loop algorithm of
+2.4.2) and `plan_robot` does it from poses for the two mobile robots.
+"""
+
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+
+from ._validation import as_matrix, as_scalar, as_vector
+from .controllability import _pair, ccf_transform, charpoly
+from .trajectory import poly_trajectory
+
+__all__ = [
+    "FlatSystem",
+    "FlatPlan",
+    "linear_flatness",
+    "pendulum_flatness",
+    "two_wheeled_flatness",
+    "car_like_flatness",
+    "plan_flat_output",
+    "plan_robot",
+]
+
+
+class FlatSystem:
+    """A system with a flat output F = phi(x) and the maps psi_x, psi_u (2.88)-(2.89).
+
+    Attributes
+    ----------
+    name : str
+    n, m : numbers of states and inputs; m flat outputs (2.93).
+    order_x, order_u : highest derivative of F that psi_x and psi_u need.
+    params : the parameters the maps were built with.
+    """
+
+    def __init__(self, *, name: str, n: int, m: int, order_x: int, order_u: int,
+                 phi: Callable, psi_x: Callable, psi_u: Callable, params: dict | None = None):
+        self.name = name
+        self.n, self.m = n, m
+        self.order_x, self.order_u = order_x, order_u
+        self._phi, self._psi_x, self._psi_u = phi, psi_x, psi_u
+        self.params = dict(params or {})
+
+    def phi(self, x) -> np.ndarray:
+        """Flat output F = phi(x); x of shape (n,) or (N, n)."""
+        arr = np.asarray(x, dtype=float)
+        single = arr.ndim == 1
+        X = as_matrix(arr.reshape(1, -1) if single else arr, "x", cols=self.n,
+                      cols_why=f"one per state of the {self.name}")
+        F = self._phi(X)
+        return F[0] if single else F
+
+    def psi_x(self, derivs) -> np.ndarray:
+        """State x = psi_x(F, ..., F^(order_x)) (2.88)."""
+        D, single = self._derivs(derivs, self.order_x)
+        x = self._psi_x(D)
+        return x[0] if single else x
+
+    def psi_u(self, derivs) -> np.ndarray:
+        """Input u = psi_u(F, ..., F^(order_u)) (2.89)."""
+        D, single = self._derivs(derivs, self.order_u)
+        u = self._psi_u(D)
+        return u[0] if single else u
+
+    def _derivs(self, derivs, order: int):
+        """Check `derivs` and return it as a list of (N, m) arrays and a single-time flag."""
+        if not isinstance(derivs, (list, tuple, np.ndarray)) or len(derivs) < order + 1:
+            got = len(derivs) if isinstance(derivs, (list, tuple, np.ndarray)) else type(derivs).__name__
+            raise ValueError(
+                f"derivs must list F and its derivatives [F, F', ..., F^({order})] for the "
+                f"{self.name}: received {got}; expected at least {order + 1} entries."
+            )
+        arrays = [np.asarray(d, dtype=float) for d in derivs[:order + 1]]
+        # one time: a number, or shape (m,); with one flat output an (N,) array lists N times
+        single = arrays[0].ndim == 0 or (arrays[0].ndim == 1 and (self.m > 1 or arrays[0].size == 1))
+        out = []
+        for k, d in enumerate(arrays):
+            d = d.reshape(1, -1) if single else (d.reshape(-1, 1) if d.ndim == 1 else d)
+            out.append(as_matrix(d, f"derivs[{k}]", cols=self.m,
+                                 cols_why=f"one per flat output of the {self.name}",
+                                 rows=out[0].shape[0] if out else None,
+                                 rows_why="one per time, like derivs[0]"))
+        return out, single
+
+    def __repr__(self) -> str:
+        return (f"FlatSystem {self.name!r}: n={self.n}, m={self.m}; x needs F..F^({self.order_x}), "
+                f"u needs F..F^({self.order_u})")
+
+
+def linear_flatness(A, B) -> FlatSystem:
+    """Flat output F = T_1 x of a controllable single-input LTI system (2.74)-(2.87).
+
+    T_1 is the first row of the CCF transform (2.65). Then
+    ``x = Lambda [F, F', ..., F^(n-1)]`` with ``Lambda = T^-1`` (2.77)-(2.78)
+    and ``u = a_0 F + ... + a_{n-1} F^(n-1) + F^(n)`` (2.79). Raises
+    `NotControllableError` for an uncontrollable pair: no flat output exists.
+    """
+    A, B = _pair(A, B)
+    n = A.shape[0]
+    T = ccf_transform(A, B)
+    a = charpoly(A)
+    Lam = np.linalg.inv(T)
+
+    def phi(X):
+        # (2.76): F = T_1 x
+        return X @ T[:1].T
+
+    def psi_x(D):
+        # (2.78): x = Lambda [F, F', ..., F^(n-1)]
+        Z = np.hstack(D[:n])
+        return Z @ Lam.T
+
+    def psi_u(D):
+        # (2.79): u = a_0 F + ... + a_{n-1} F^(n-1) + F^(n)
+        return np.hstack(D[:n]) @ a.reshape(-1, 1) + D[n]
+
+    flat = FlatSystem(name="linear system", n=n, m=1, order_x=n - 1, order_u=n,
+                      phi=phi, psi_x=psi_x, psi_u=psi_u, params=dict(A=A, B=B))
+    flat.T1, flat.Lambda, flat.a = T[0].copy(), Lam, a
+    return flat
+
+
+def pendulum_flatness(m: float = 1.0, l: float = 1.0, g: float = 9.81,
+                      d_theta: float = 0.0) -> FlatSystem:
+    """Flat output F = theta of the pendulum (2.90)-(2.92), same parameters as `models.pendulum`.
+
+    ``x = [F, F']`` (2.91) and ``u = m l^2 F'' + d_theta l^2 F' + m g l sin F``:
+    (2.92) plus the damping term of (1.8) (zero by default, as in (2.90)).
+    """
+    m, l = as_scalar(m, "m", positive=True), as_scalar(l, "l", positive=True)
+    g, d_theta = as_scalar(g, "g"), as_scalar(d_theta, "d_theta")
+
+    def phi(X):
+        return X[:, :1]
+
+    def psi_x(D):
+        # (2.91): x1 = F, x2 = F'
+        return np.hstack([D[0], D[1]])
+
+    def psi_u(D):
+        # (2.92) with damping: tau = m l^2 F'' + d_theta l^2 F' + m g l sin F
+        return m * l**2 * D[2] + d_theta * l**2 * D[1] + m * g * l * np.sin(D[0])
+
+    return FlatSystem(name="pendulum", n=2, m=1, order_x=1, order_u=2, phi=phi,
+                      psi_x=psi_x, psi_u=psi_u, params=dict(m=m, l=l, g=g, d_theta=d_theta))
+
+
+def _speed_squared(D, name: str) -> np.ndarray:
+    """|F'|^2 of a planar robot, after checking it is away from the zero-speed singularity."""
+    dF = D[1]
+    speed_sq = np.sum(dF**2, axis=1, keepdims=True)
+    scale = max(1.0, float(np.sqrt(speed_sq.max())))
+    if np.any(np.sqrt(speed_sq) <= 1e-9 * scale):
+        k = int(np.argmin(speed_sq))
+        raise ValueError(
+            f"the flat parametrization of the {name} is singular at zero speed: at sample {k} "
+            f"F' = {dF[k].tolist()}, so |F'| = 0. The heading theta = atan2(F2', F1') (2.97) is "
+            "the direction of motion and does not exist when the robot stands still, and the "
+            "turn rate (2.101) divides by |F'|^2. Plan with a nonzero speed at both ends "
+            "(e.g. plan_robot(..., speed=1.0)) so that F' never vanishes on [0, T]."
+        )
+    return speed_sq
+
+
+def _heading(D, sign: float) -> np.ndarray:
+    # (2.97) with the quadrant fixed: theta = atan2(s F2', s F1'), s = sign of the speed
+    return np.arctan2(sign * D[1][:, 1:2], sign * D[1][:, 0:1])
+
+
+def _turn_rate(D, speed_sq) -> np.ndarray:
+    # (2.101): theta' = (F2'' F1' - F1'' F2') / (F1'^2 + F2'^2)
+    return (D[2][:, 1:2] * D[1][:, 0:1] - D[2][:, 0:1] * D[1][:, 1:2]) / speed_sq
+
+
+def _planar_phi(X):
+    # F = (x1, x2), the position (2.95)
+    return X[:, :2]
+
+
+def two_wheeled_flatness(reverse: bool = False) -> FlatSystem:
+    """Flat output F = (x1, x2) of the two-wheeled robot (2.94)-(2.102).
+
+    ``theta = atan2(F2', F1')`` ((2.97) with the quadrant fixed; the notes'
+    arctan(F2'/F1') is wrong whenever the robot drives in -x1 direction),
+    ``u1 = |F'|`` (2.99) and ``u2 = (F2'' F1' - F1'' F2') / |F'|^2`` (2.101).
+    With ``reverse=True`` the robot drives backwards: u1 = -|F'| and theta
+    is turned by pi. Singular at zero speed (F' = 0), where a ValueError
+    explains why.
+    """
+    def turn_rate(D, speed_sq, v):
+        # (2.100)-(2.101): u2 = theta'
+        return _turn_rate(D, speed_sq)
+
+    return _robot_flatness("two-wheeled robot", reverse, turn_rate, {})
+
+
+def car_like_flatness(L: float = 2.5, reverse: bool = False) -> FlatSystem:
+    """Flat output F = (x1, x2) of the car-like robot (1.11): the exercise of 2.4 solved.
+
+    The first two equations of (1.11) are those of the two-wheeled robot, so
+    ``theta = atan2(F2', F1')`` and ``v = |F'|`` as in (2.97)-(2.99), and
+    ``theta' = (F2'' F1' - F1'' F2') / |F'|^2`` (2.101). The third equation
+    ``theta' = v tan(delta) / L`` then gives the steering angle::
+
+        delta = arctan(L theta' / v) = arctan(L (F2'' F1' - F1'' F2') / (v |F'|^2)),
+
+    i.e. arctan(L kappa) with kappa the curvature of the path. Same
+    parameter L [m] as `models.car_like_robot`; singular at zero speed.
+    """
+    L = as_scalar(L, "L", positive=True)
+
+    def steering(D, speed_sq, v):
+        # (1.11): theta' = v tan(delta) / L, so delta = arctan(L theta' / v)
+        return np.arctan(L * _turn_rate(D, speed_sq) / v)
+
+    return _robot_flatness("car-like robot", reverse, steering, dict(L=L))
+
+
+def _robot_flatness(name: str, reverse: bool, second_input: Callable, params: dict) -> FlatSystem:
+    """The flat maps shared by both robots; `second_input(D, |F'|^2, v)` gives u2."""
+    sign = -1.0 if reverse else 1.0
+
+    def psi_x(D):
+        _speed_squared(D, name)
+        return np.hstack([D[0], _heading(D, sign)])
+
+    def psi_u(D):
+        speed_sq = _speed_squared(D, name)
+        # (2.99): u1 = +-sqrt(F1'^2 + F2'^2), the sign chosen by the driving direction
+        v = sign * np.sqrt(speed_sq)
+        return np.hstack([v, second_input(D, speed_sq, v)])
+
+    return FlatSystem(name=name, n=3, m=2, order_x=1, order_u=2, phi=_planar_phi,
+                      psi_x=psi_x, psi_u=psi_u, params=dict(params, reverse=bool(reverse)))
+
+
+class FlatPlan:
+    """A planned flat output F_d on [0, T] and the state and input it implies.
+
+    Attributes: ``flat`` (the `FlatSystem`), ``horizon`` (T), ``trajectories``
+    (one `PolyTrajectory` per flat output). Methods: ``F(t, k=0)`` (shape
+    (N, m)), ``x(t)`` and ``u(t)`` from psi_x and psi_u, and ``input(t, x)``
+    for `simulate`. Times are clipped to [0, T]: the end values are held.
+    """
+
+    def __init__(self, flat: FlatSystem, horizon: float, trajectories: list):
+        self.flat = flat
+        self.horizon = horizon
+        self.trajectories = trajectories
+
+    def _clip(self, t):
+        tt = as_vector(t, "t")
+        return np.clip(tt, 0.0, self.horizon), np.ndim(t) == 0
+
+    def F(self, t, k: int = 0) -> np.ndarray:
+        """k-th derivative of the planned flat output, shape (N, m) (or (m,) for one time)."""
+        tt, single = self._clip(t)
+        values = np.column_stack([traj(tt, k) for traj in self.trajectories])
+        return values[0] if single else values
+
+    def derivs(self, t, order: int) -> list:
+        """[F_d, F_d', ..., F_d^(order)] at the times t, each of shape (N, m)."""
+        tt, _ = self._clip(t)
+        return [np.column_stack([traj(tt, k) for traj in self.trajectories]) for k in range(order + 1)]
+
+    def x(self, t) -> np.ndarray:
+        """Planned state psi_x(F_d, ...) (2.88), shape (N, n)."""
+        out = self.flat.psi_x(self.derivs(t, self.flat.order_x))
+        return out[0] if np.ndim(t) == 0 else out
+
+    def u(self, t) -> np.ndarray:
+        """Feedforward input u_d = psi_u(F_d, ...) (2.89), shape (N, m)."""
+        out = self.flat.psi_u(self.derivs(t, self.flat.order_u))
+        return out[0] if np.ndim(t) == 0 else out
+
+    def input(self, t, x=None) -> np.ndarray:
+        """``u(t, x)`` for `simulate`: open loop, x is ignored (t is clipped to [0, T])."""
+        tt = min(max(float(t), 0.0), self.horizon)
+        # the same maps as u(t), without re-checking the inputs at every solver step
+        columns = [traj._scalar_derivatives(tt, self.flat.order_u) for traj in self.trajectories]
+        D = [np.array([[col[k] for col in columns]]) for k in range(self.flat.order_u + 1)]
+        return self.flat._psi_u(D)[0]
+
+    @property
+    def x0(self) -> np.ndarray:
+        """Planned state at t = 0."""
+        return self.x(0.0)
+
+    @property
+    def xT(self) -> np.ndarray:
+        """Planned state at t = T."""
+        return self.x(self.horizon)
+
+    def __repr__(self) -> str:
+        return (f"FlatPlan for the {self.flat.name} over [0, {self.horizon:g}]: "
+                f"x0 = {np.round(self.x0, 6).tolist()}, xT = {np.round(self.xT, 6).tolist()}")
+
+
+def _boundary(value, name: str, m: int) -> np.ndarray:
+    """Boundary conditions as an (r, m) array: row k is the k-th derivative of F."""
+    arr = np.asarray(value, dtype=float)
+    if m == 1 and arr.ndim <= 1:
+        return as_vector(value, name).reshape(-1, 1)
+    return as_matrix(value, name, cols=m, cols_why=f"one per flat output (m = {m})")
+
+
+def plan_flat_output(flat: FlatSystem, T, start, end) -> FlatPlan:
+    """Open-loop plan for a flat system (the algorithm of 2.4.2).
+
+    `start` and `end` give F and its first r - 1 derivatives at t = 0 and
+    t = T, as an (r, m) array (row k = k-th derivative; a 1-D list when
+    m = 1). Each flat output gets the polynomial of degree 2r - 1 of
+    `poly_trajectory`; the input is ``u_d = psi_u(F_d, ..., F_d^(n))``.
+    Choose r so that the state's boundary values are matched (r > order_x)
+    and, for an input without jumps at the ends, one more.
+    """
+    if not isinstance(flat, FlatSystem):
+        raise ValueError(f"flat must be a FlatSystem (e.g. pendulum_flatness()): received "
+                         f"{type(flat).__name__}.")
+    T = as_scalar(T, "T", positive=True)
+    S = _boundary(start, "start", flat.m)
+    E = _boundary(end, "end", flat.m)
+    if S.shape != E.shape:
+        raise ValueError(f"end must have the shape of start: received {E.shape}, expected {S.shape} "
+                         "(the same derivatives at both ends).")
+    trajs = [poly_trajectory(T, S[:, j], E[:, j]) for j in range(flat.m)]
+    return FlatPlan(flat, T, trajs)
+
+
+def plan_robot(start, end, T, *, speed=1.0, L: float | None = None) -> FlatPlan:
+    """Plan a manoeuvre of the two-wheeled robot (L=None) or of the car-like robot (wheelbase L).
+
+    `start` and `end` are poses (x1, x2, theta) [m, m, rad]; `speed` [m/s]
+    is the speed at both ends, or a pair (v0, vT). The flat output
+    F = (x1, x2) gets cubic polynomials (2.31)-(2.38) with
+    ``F'(0) = v0 (cos theta0, sin theta0)`` and ``F'(T) = vT (cos thetaT, sin thetaT)``,
+    so the pose is met at both ends. Both speeds must be nonzero and of one
+    sign (negative: reversing): at zero speed the heading is undefined (the
+    singularity of (2.97)-(2.101)). The smallest planned speed on [0, T] is
+    found exactly (roots of d|F'|^2/dt) and stored as ``plan.min_speed``; a
+    ValueError explains a plan whose speed vanishes on the way.
+    """
+    start = as_vector(start, "start", size=3, why="a pose (x1, x2, theta)")
+    end = as_vector(end, "end", size=3, why="a pose (x1, x2, theta)")
+    T = as_scalar(T, "T", positive=True)
+    v = as_vector(speed, "speed")
+    v0, vT = (v[0], v[0]) if v.size == 1 else tuple(as_vector(speed, "speed", size=2, why="(v0, vT)"))
+    if v0 == 0 or vT == 0 or np.sign(v0) != np.sign(vT):
+        raise ValueError(
+            f"speed must be nonzero and of the same sign at both ends: received v0 = {v0:g}, "
+            f"vT = {vT:g}. A flat plan through zero speed is singular: the heading theta = "
+            "atan2(F2', F1') (2.97) is undefined when the robot stands still, so it cannot be set "
+            "by the boundary conditions. Start and end moving (e.g. speed=0.5), or turn on the "
+            "spot first with u1 = 0, u2 != 0 and plan from there."
+        )
+    reverse = v0 < 0
+    flat = two_wheeled_flatness(reverse) if L is None else car_like_flatness(L, reverse)
+    S = [start[:2], v0 * np.array([np.cos(start[2]), np.sin(start[2])])]
+    E = [end[:2], vT * np.array([np.cos(end[2]), np.sin(end[2])])]
+    plan = plan_flat_output(flat, T, S, E)
+    t_min, plan.min_speed = _slowest_point(plan)
+    if plan.min_speed <= 1e-6 * max(abs(v0), abs(vT)):
+        raise ValueError(
+            f"the planned path stops on the way: its speed |F'| is {plan.min_speed:.2g} m/s at "
+            f"t = {t_min:.4g} s. There the flat parametrization is singular (the heading (2.97) "
+            "is undefined and flips by pi, the turn rate (2.101) divides by zero), so the robot "
+            "cannot follow the plan; typical cause: the target lies behind the start and the "
+            "path reverses. Add an intermediate pose, change the target heading, or plan "
+            "the reversing part separately with a negative speed."
+        )
+    return plan
+
+
+def _slowest_point(plan: FlatPlan):
+    """(t, |F'(t)|) where the planned speed is smallest on [0, T], from the roots of d|F'|^2/dt."""
+    P = np.polynomial.Polynomial
+    # F_j as polynomials in the centred time s = 2 t / T - 1; F_j' in s is proportional to F_j' in t
+    vel = [P(traj._derivs[1]) for traj in plan.trajectories]
+    speed_sq = sum(v * v for v in vel)
+    roots = speed_sq.deriv().roots()
+    s = np.concatenate([[-1.0, 1.0], roots.real[(np.abs(roots.imag) < 1e-9) & (np.abs(roots.real) <= 1)]])
+    k = int(np.argmin(speed_sq(s)))
+    t = (s[k] + 1.0) * plan.horizon / 2.0
+    return float(t), float(np.linalg.norm(plan.F(t, 1)))

@@ -1,0 +1,221 @@
+"""Symbolic versions of chapter 2's computations, with sympy.
+
+* `symbolic_ctrb(A, B)`: Wc = [B, AB, ..., A^(n-1) B] (2.13) for matrices
+  with symbols, e.g. `symbolic_mass_spring_damper()` in m, d, k (2.27);
+* `symbolic_linear_flatness(A, B)`: F = T_1 x, psi_x and psi_u (2.74)-(2.87)
+  in exact arithmetic;
+* `symbolic_flat_maps(system)`: psi_x, psi_u of the pendulum, the
+  two-wheeled robot and the car-like robot *derived* by sympy from the model
+  equations, as in (2.90)-(2.102).
+
+sympy is imported inside the functions, so ``import coursekit`` stays fast.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+__all__ = [
+    "SymbolicFlatMaps",
+    "symbolic_ctrb",
+    "symbolic_mass_spring_damper",
+    "symbolic_linear_flatness",
+    "symbolic_flat_maps",
+]
+
+_SYSTEMS = ("pendulum", "two_wheeled", "car_like")
+
+
+def _sym_matrix(value, name: str):
+    import sympy as sp
+    try:
+        M = sp.Matrix(value)
+    except (TypeError, ValueError, sp.SympifyError) as err:
+        raise ValueError(f"{name} must be a matrix (nested list or sympy Matrix): received "
+                         f"{type(value).__name__} ({err}).") from None
+    return M
+
+
+def _sym_pair(A, B):
+    A, B = _sym_matrix(A, "A"), _sym_matrix(B, "B")
+    if not A.is_square or A.rows == 0:
+        raise ValueError(f"A must be square: received shape {A.shape}, expected (n, n).")
+    if B.rows != A.rows:
+        raise ValueError(f"B has the wrong number of rows: received shape {B.shape}, "
+                         f"expected {A.rows} rows (one per state, since A is {A.rows}x{A.rows}).")
+    return A, B
+
+
+def symbolic_ctrb(A, B):
+    """Controllability matrix Wc = [B, AB, ..., A^(n-1) B] (2.13) as a sympy Matrix."""
+    import sympy as sp
+    A, B = _sym_pair(A, B)
+    blocks = [B]
+    for _ in range(A.rows - 1):
+        blocks.append(A * blocks[-1])
+    return sp.Matrix.hstack(*blocks)
+
+
+def symbolic_mass_spring_damper():
+    """(A, B) of the mass-spring-damper (2.27) with positive symbols m, d, k."""
+    import sympy as sp
+    m, d, k = sp.symbols("m d k", positive=True)
+    A = sp.Matrix([[0, 1], [-k / m, -d / m]])
+    B = sp.Matrix([[0], [1 / m]])
+    return A, B
+
+
+@dataclass
+class SymbolicFlatMaps:
+    """psi_x and psi_u as sympy expressions of plain symbols for F and its derivatives.
+
+    ``derivs[k][j]`` is the symbol for the k-th derivative of the j-th flat
+    output; ``psi_x`` and ``psi_u`` are column Matrices in these symbols.
+    ``functions()`` turns them into numerical functions with FlatSystem's
+    calling convention (one time: ``derivs[k]`` has one entry per flat output).
+    """
+
+    name: str
+    derivs: list
+    psi_x: object
+    psi_u: object
+
+    def functions(self):
+        """(psi_x, psi_u) as numerical functions of ``[F, F', ...]`` (numpy, via lambdify)."""
+        import numpy as np
+        import sympy as sp
+        flat = [s for row in self.derivs for s in row]
+        fx = sp.lambdify(flat, self.psi_x, "numpy")
+        fu = sp.lambdify(flat, self.psi_u, "numpy")
+        m = len(self.derivs[0])
+
+        def call(func, values):
+            args = [np.atleast_1d(np.asarray(values[k], dtype=float)) for k in range(len(self.derivs))]
+            return np.asarray(func(*[a[j] for a in args for j in range(m)]), dtype=float).ravel()
+
+        return (lambda values: call(fx, values)), (lambda values: call(fu, values))
+
+
+def _derivative_symbols(order: int, m: int):
+    import sympy as sp
+    if m == 1:
+        return [[sp.Symbol(f"F_{k}")] for k in range(order + 1)]
+    return [[sp.Symbol(f"F{j + 1}_{k}") for j in range(m)] for k in range(order + 1)]
+
+
+def _to_symbols(expr, funcs, t, derivs):
+    """Replace F_j(t) and its time derivatives by the plain symbols derivs[k][j]."""
+    import sympy as sp
+    for k in reversed(range(len(derivs))):
+        for j, F in enumerate(funcs):
+            expr = expr.subs(sp.diff(F, t, k) if k else F, derivs[k][j])
+    return expr
+
+
+def symbolic_linear_flatness(A, B) -> SymbolicFlatMaps:
+    """F = T_1 x for a controllable single-input (A, B), in exact arithmetic (2.74)-(2.87).
+
+    T_1 = e_n^T Wc^-1 (2.65), T_{i+1} = T_i A (2.61), x = T^-1 [F, ..., F^(n-1)]
+    (2.78), u = a_0 F + ... + a_{n-1} F^(n-1) + F^(n) (2.79). Raises
+    ValueError when Wc is singular. The result also carries ``T1`` and ``a``.
+    """
+    import sympy as sp
+    A, B = _sym_pair(A, B)
+    n = A.rows
+    if B.cols != 1:
+        raise ValueError(f"B must have a single column: received shape {B.shape}.")
+    Wc = symbolic_ctrb(A, B)
+    if sp.simplify(Wc.det()) == 0:
+        raise ValueError("(A, B) is not controllable: det Wc = 0 (2.13), so no flat output "
+                         "F = T_1 x exists (2.65); check B and A.")
+    e_n = sp.zeros(1, n)
+    e_n[n - 1] = 1
+    # (2.65): T_1 = e_n^T Wc^-1
+    rows = [sp.simplify(e_n * Wc.inv())]
+    # (2.61): T_{i+1} = T_i A
+    for _ in range(n - 1):
+        rows.append(sp.simplify(rows[-1] * A))
+    T = sp.Matrix.vstack(*rows)
+    s = sp.Symbol("s")
+    a = list(reversed(A.charpoly(s).all_coeffs()))[:-1]
+    derivs = _derivative_symbols(n, 1)
+    Z = sp.Matrix([derivs[k][0] for k in range(n)])
+    # (2.78): x = Lambda z with Lambda = T^-1; (2.79): u = sum a_i F^(i) + F^(n)
+    psi_x = sp.simplify(T.inv() * Z)
+    psi_u = sp.Matrix([sp.expand(sum(a[i] * derivs[i][0] for i in range(n)) + derivs[n][0])])
+    maps = SymbolicFlatMaps("linear system", derivs, psi_x, psi_u)
+    maps.T1, maps.a = T[0, :], a
+    return maps
+
+
+def _pendulum():
+    """(2.90)-(2.92): F = theta; x2 = F'; tau from the second state equation (with damping)."""
+    import sympy as sp
+    t, u = sp.symbols("t u")
+    m, l, g = sp.symbols("m l g", positive=True)
+    d = sp.Symbol("d_theta", nonnegative=True)
+    F = sp.Function("F")(t)
+    x1 = F
+    # first equation x1' = x2 gives x2 = F'
+    x2 = sp.diff(x1, t)
+    # second equation (1.8): m l^2 x2' + d l^2 x2 + m g l sin x1 = u, solved for u
+    u_expr = sp.solve(sp.Eq(m * l**2 * sp.diff(x2, t) + d * l**2 * x2 + m * g * l * sp.sin(x1), u), u)[0]
+    derivs = _derivative_symbols(2, 1)
+    psi_x = sp.Matrix([_to_symbols(e, [F], t, derivs) for e in (x1, x2)])
+    psi_u = sp.Matrix([_to_symbols(u_expr, [F], t, derivs)])
+    return "pendulum", derivs, psi_x, psi_u
+
+
+def _planar(car: bool):
+    """(2.94)-(2.102) and the car-like exercise: F = (x1, x2), derived from the model."""
+    import sympy as sp
+    t = sp.Symbol("t")
+    F1, F2 = sp.Function("F1")(t), sp.Function("F2")(t)
+    v = sp.Symbol("v", positive=True)
+    d1, d2 = sp.diff(F1, t), sp.diff(F2, t)
+    # (2.98): squaring and adding the first two equations: v^2 = F1'^2 + F2'^2, forward root
+    roots = sp.solve(sp.Eq(v**2, d1**2 + d2**2), v)
+    speed = next(r for r in roots if not r.could_extract_minus_sign())
+    # (2.96)-(2.97): dividing them: tan(theta) = F2'/F1'; atan2 picks the quadrant of (cos, sin)
+    theta = sp.atan2(d2, d1)
+    # (2.100)-(2.101): theta' by differentiation
+    theta_dot = sp.simplify(sp.diff(theta, t))
+    derivs = _derivative_symbols(2, 2)
+    funcs = [F1, F2]
+    psi_x = sp.Matrix([_to_symbols(e, funcs, t, derivs) for e in (F1, F2, theta)])
+    if car:
+        L = sp.Symbol("L", positive=True)
+        delta = sp.Symbol("delta")
+        # (1.11): theta' = v tan(delta) / L, solved for delta
+        second = sp.solve(sp.Eq(theta_dot, speed * sp.tan(delta) / L), delta)[0]
+    else:
+        # (2.94): theta' = u2
+        second = theta_dot
+    psi_u = sp.Matrix([_to_symbols(sp.simplify(e), funcs, t, derivs) for e in (speed, second)])
+    name = "car-like robot" if car else "two-wheeled robot"
+    return name, derivs, psi_x, psi_u
+
+
+def symbolic_flat_maps(system: str, **params) -> SymbolicFlatMaps:
+    """Derive psi_x and psi_u with sympy from the model equations.
+
+    `system` is ``"pendulum"`` (2.90)-(2.92, with damping d_theta),
+    ``"two_wheeled"`` (2.94)-(2.102) or ``"car_like"`` (the exercise; forward
+    driving). Keyword `params` (e.g. ``m=1, l=0.5, g=9.81, d_theta=0`` or
+    ``L=2.5``) are substituted for the symbols of the same name; the others stay symbolic.
+    """
+    import sympy as sp
+    if system not in _SYSTEMS:
+        raise ValueError(f"system must be one of {_SYSTEMS}: received {system!r}.")
+    if system == "pendulum":
+        name, derivs, psi_x, psi_u = _pendulum()
+    else:
+        name, derivs, psi_x, psi_u = _planar(car=system == "car_like")
+    known = {s.name: s for s in (psi_x.free_symbols | psi_u.free_symbols)}
+    for key, value in params.items():
+        if key not in known and not any(key == s.name for row in derivs for s in row):
+            allowed = sorted(k for k in known if not k.startswith("F"))
+            raise ValueError(f"{key} is not a parameter of the {name}: expected one of {allowed}.")
+        if key in known:
+            psi_x, psi_u = psi_x.subs(known[key], value), psi_u.subs(known[key], value)
+    return SymbolicFlatMaps(name, derivs, sp.Matrix(psi_x), sp.Matrix(psi_u))

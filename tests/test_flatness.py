@@ -1,0 +1,139 @@
+"""Flat outputs and the maps psi_x, psi_u (section 2.4)."""
+
+import numpy as np
+import pytest
+from hypothesis import given, strategies as st
+
+import coursekit as ck
+
+
+def test_linear_example_2_80_gives_2_84_and_2_86():
+    flat = ck.linear_flatness([[0, 2], [1, -3]], [[1], [0]])
+    np.testing.assert_allclose(flat.T1, [0, 1])  # F = x2 (2.82)
+    F, dF, ddF = 0.7, -1.3, 2.1
+    # (2.84): x1 = 3F + F', x2 = F
+    np.testing.assert_allclose(flat.psi_x([F, dF]), [3 * F + dF, F])
+    # (2.86): u = -2F + 3F' + F''
+    np.testing.assert_allclose(flat.psi_u([F, dF, ddF]), [-2 * F + 3 * dF + ddF])
+    np.testing.assert_allclose(flat.phi([0.2, 0.5]), [0.5])
+
+
+@given(n=st.integers(1, 4), seed=st.integers(0, 10_000))
+def test_linear_flatness_is_consistent_with_the_dynamics(n, seed):
+    rng = np.random.default_rng(seed)
+    A, B = rng.normal(size=(n, n)), rng.normal(size=(n, 1))
+    if np.linalg.cond(ck.ctrb(A, B)) > 1e6:
+        return
+    flat = ck.linear_flatness(A, B)
+    # along any F(t): x = psi_x, u = psi_u must satisfy x' = A x + B u
+    derivs = [float(v) for v in rng.normal(size=n + 1)]
+    x = flat.psi_x(derivs)
+    x_dot = flat.psi_x(derivs[1:])  # psi_x is linear: its derivative uses F', ..., F^(n)
+    u = flat.psi_u(derivs)
+    size = 1 + np.abs(x_dot).max() + np.abs(A @ x).max()
+    np.testing.assert_allclose(x_dot, A @ x + B[:, 0] * u[0], atol=1e-7 * size)
+    # phi inverts psi_x on F
+    np.testing.assert_allclose(flat.phi(x), derivs[0], atol=1e-8 * (1 + np.abs(x).max()))
+
+
+def test_linear_flatness_not_controllable():
+    with pytest.raises(ck.NotControllableError, match=r"not controllable"):
+        ck.linear_flatness([[-1, 1, 0], [1, -1, 1], [0, 1, -1]], [[0], [1], [0]])
+
+
+def test_pendulum_psi_u_is_2_92_plus_damping():
+    flat = ck.pendulum_flatness(m=2.0, l=0.5, g=9.81, d_theta=0.1)
+    F, dF, ddF = 0.4, 0.3, -1.0
+    np.testing.assert_allclose(flat.psi_x([F, dF]), [F, dF])
+    expected = 2.0 * 0.25 * ddF + 0.1 * 0.25 * dF + 2.0 * 9.81 * 0.5 * np.sin(F)
+    np.testing.assert_allclose(flat.psi_u([F, dF, ddF]), [expected])
+
+
+def test_pendulum_swing_on_the_nonlinear_model():
+    flat = ck.pendulum_flatness(m=1.0, l=0.5, d_theta=0.2)
+    plan = ck.plan_flat_output(flat, 2.0, [0.0, 0.0, 0.0], [np.pi / 3, 0.0, 0.0])
+    t = np.linspace(0, 2, 201)
+    res = ck.simulate(ck.models.pendulum(m=1.0, l=0.5, d_theta=0.2), t, u=plan.input, x0=plan.x0)
+    np.testing.assert_allclose(res.x, plan.x(t), atol=1e-6)
+    np.testing.assert_allclose(res.x[-1], [np.pi / 3, 0.0], atol=1e-6)
+    # with F''(T) = 0 the end torque is the holding torque m g l sin(theta_T)
+    np.testing.assert_allclose(plan.u(2.0), [9.81 * 0.5 * np.sin(np.pi / 3)])
+
+
+@pytest.mark.parametrize("L", [None, 2.5])
+@pytest.mark.parametrize("speed", [1.0, -0.8])
+def test_robot_manoeuvres_are_driven_by_the_nonlinear_models(L, speed):
+    start, end = [0.0, 0.0, 0.0], [4.0, 3.0, np.pi / 2]
+    if speed < 0:
+        end = [-4.0, 3.0, -np.pi / 2]
+    plan = ck.plan_robot(start, end, 6.0, speed=speed, L=L)
+    model = ck.models.two_wheeled_robot() if L is None else ck.models.car_like_robot(L)
+    t = np.linspace(0, 6, 301)
+    res = ck.simulate(model, t, u=plan.input, x0=start)
+    np.testing.assert_allclose(res.x[-1, :2], end[:2], atol=1e-6)
+    # headings agree modulo 2 pi
+    np.testing.assert_allclose(np.cos(res.x[-1, 2] - end[2]), 1.0, atol=1e-9)
+    assert np.sign(plan.u(3.0)[0]) == np.sign(speed)
+    assert plan.min_speed > 0
+
+
+def test_two_wheeled_psi_matches_2_97_and_2_102():
+    flat = ck.two_wheeled_flatness()
+    F, dF, ddF = np.array([1.0, 2.0]), np.array([-3.0, 4.0]), np.array([0.5, -1.0])
+    x = flat.psi_x([F, dF])
+    np.testing.assert_allclose(x, [1.0, 2.0, np.arctan2(4.0, -3.0)])
+    # the notes' arctan(F2'/F1') would point the wrong way here: quadrant II
+    assert x[2] > np.pi / 2
+    u = flat.psi_u([F, dF, ddF])
+    np.testing.assert_allclose(u, [5.0, (-1.0 * -3.0 - 0.5 * 4.0) / 25.0])
+
+
+def test_car_like_steering_angle_from_the_curvature():
+    L = 2.5
+    flat = ck.car_like_flatness(L)
+    # a circle of radius R driven at speed v: F = R (sin(w t), 1 - cos(w t)), w = v / R
+    R, v, t = 10.0, 2.0, 0.7
+    w = v / R
+    F = R * np.array([np.sin(w * t), 1 - np.cos(w * t)])
+    dF = R * w * np.array([np.cos(w * t), np.sin(w * t)])
+    ddF = R * w**2 * np.array([-np.sin(w * t), np.cos(w * t)])
+    u = flat.psi_u([F, dF, ddF])
+    np.testing.assert_allclose(u, [v, np.arctan(L / R)])
+    np.testing.assert_allclose(flat.psi_x([F, dF])[2], w * t)
+
+
+def test_time_major_evaluation():
+    flat = ck.two_wheeled_flatness()
+    N = 5
+    derivs = [np.ones((N, 2)), np.tile([1.0, 1.0], (N, 1)), np.zeros((N, 2))]
+    assert flat.psi_x(derivs).shape == (N, 3)
+    assert flat.psi_u(derivs).shape == (N, 2)
+
+
+def test_zero_speed_singularity_is_explained():
+    flat = ck.two_wheeled_flatness()
+    with pytest.raises(ValueError, match=r"singular at zero speed.*atan2\(F2', F1'\) \(2.97\)"):
+        flat.psi_u([[0, 0], [0, 0], [1, 0]])
+    with pytest.raises(ValueError, match=r"speed must be nonzero and of the same sign at both ends"):
+        ck.plan_robot([0, 0, 0], [3, 1, 0], 5.0, speed=0.0)
+    with pytest.raises(ValueError, match=r"speed must be nonzero and of the same sign"):
+        ck.plan_robot([0, 0, 0], [3, 1, 0], 5.0, speed=[1.0, -1.0])
+    # straight back along the x1 axis: F1' goes from +1 to -1 and passes through zero
+    with pytest.raises(ValueError, match=r"the planned path stops on the way"):
+        ck.plan_robot([0, 0, 0], [-3, 0, np.pi], 5.0, speed=1.0)
+
+
+def test_flatness_bad_input():
+    flat = ck.pendulum_flatness()
+    with pytest.raises(ValueError, match=r"derivs must list F and its derivatives \[F, F', \.\.\., F\^\(2\)\]"):
+        flat.psi_u([0.1, 0.2])
+    with pytest.raises(ValueError, match=r"derivs\[1\] has the wrong number of columns"):
+        ck.two_wheeled_flatness().psi_x([[1, 2], [1, 2, 3]])
+    with pytest.raises(ValueError, match=r"flat must be a FlatSystem"):
+        ck.plan_flat_output("pendulum", 1.0, [0, 0], [1, 0])
+    with pytest.raises(ValueError, match=r"end must have the shape of start"):
+        ck.plan_flat_output(flat, 1.0, [0, 0, 0], [1, 0])
+    with pytest.raises(ValueError, match=r"start has the wrong length: received 2 entries, expected 3"):
+        ck.plan_robot([0, 0], [1, 1, 0], 1.0)
+    with pytest.raises(ValueError, match=r"L must be positive"):
+        ck.car_like_flatness(L=0)

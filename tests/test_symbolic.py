@@ -1,0 +1,74 @@
+"""sympy derivations against the numerical functions."""
+
+import numpy as np
+import pytest
+import sympy as sp
+
+import coursekit as ck
+
+
+def test_mass_spring_damper_ctrb_and_determinant():
+    A, B = ck.symbolic_mass_spring_damper()
+    W = ck.symbolic_ctrb(A, B)
+    m, d, k = sp.symbols("m d k", positive=True)
+    assert sp.simplify(W - sp.Matrix([[0, 1 / m], [1 / m, -d / m**2]])) == sp.zeros(2, 2)
+    # det Wc = -1/m^2 != 0 for every mass: controllable for all m, d, k
+    assert sp.simplify(W.det() + 1 / m**2) == 0
+    # agrees with the numerical ctrb for one choice of the parameters
+    values = {m: 2.0, d: 0.5, k: 3.0}
+    sys = ck.models.mass_spring_damper(m=2.0, d=0.5, k=3.0)
+    np.testing.assert_allclose(np.array(W.subs(values), dtype=float), ck.ctrb(sys.A, sys.B))
+
+
+def test_symbolic_ctrb_of_2_14():
+    W = ck.symbolic_ctrb([[-1, 1, 0], [1, -1, 1], [0, 1, -1]], [[0], [1], [0]])
+    assert W == sp.Matrix([[0, 1, -2], [1, -1, 3], [0, 1, -2]])
+    assert W.det() == 0
+
+
+def test_symbolic_linear_flatness_of_2_80():
+    maps = ck.symbolic_linear_flatness([[0, 2], [1, -3]], [[1], [0]])
+    F0, F1, F2 = (row[0] for row in maps.derivs)
+    assert maps.T1 == sp.Matrix([[0, 1]])
+    assert sp.simplify(maps.psi_x - sp.Matrix([3 * F0 + F1, F0])) == sp.zeros(2, 1)
+    assert sp.expand(maps.psi_u[0] - (-2 * F0 + 3 * F1 + F2)) == 0
+
+
+@pytest.mark.parametrize("system, params, flat", [
+    ("pendulum", dict(m=1.5, l=0.8, g=9.81, d_theta=0.3),
+     lambda: ck.pendulum_flatness(m=1.5, l=0.8, g=9.81, d_theta=0.3)),
+    ("two_wheeled", {}, ck.two_wheeled_flatness),
+    ("car_like", dict(L=2.5), lambda: ck.car_like_flatness(2.5)),
+])
+def test_symbolic_maps_equal_the_numerical_ones(system, params, flat):
+    maps = ck.symbolic_flat_maps(system, **params)
+    fx, fu = maps.functions()
+    numeric = flat()
+    rng = np.random.default_rng(3)
+    for _ in range(5):
+        derivs = [rng.normal(size=numeric.m) for _ in range(3)]
+        np.testing.assert_allclose(fx(derivs), numeric.psi_x(derivs), rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(fu(derivs), numeric.psi_u(derivs), rtol=1e-12, atol=1e-12)
+
+
+def test_derived_robot_maps_satisfy_the_model():
+    maps = ck.symbolic_flat_maps("two_wheeled")
+    (F1, F2), (dF1, dF2), _ = maps.derivs
+    theta = maps.psi_x[2]
+    u1 = maps.psi_u[0]
+    # (2.94): x1' = u1 cos(theta), x2' = u1 sin(theta)
+    assert sp.simplify(u1 * sp.cos(theta) - dF1) == 0
+    assert sp.simplify(u1 * sp.sin(theta) - dF2) == 0
+
+
+def test_symbolic_bad_input():
+    with pytest.raises(ValueError, match=r"system must be one of"):
+        ck.symbolic_flat_maps("bicycle")
+    with pytest.raises(ValueError, match=r"mass is not a parameter of the pendulum"):
+        ck.symbolic_flat_maps("pendulum", mass=1.0)
+    with pytest.raises(ValueError, match=r"A must be square"):
+        ck.symbolic_ctrb([[1, 2, 3]], [[1]])
+    with pytest.raises(ValueError, match=r"B has the wrong number of rows"):
+        ck.symbolic_ctrb([[1, 0], [0, 1]], [[1], [0], [0]])
+    with pytest.raises(ValueError, match=r"not controllable: det Wc = 0"):
+        ck.symbolic_linear_flatness([[-3, 0], [1, -2]], [[0], [1]])
