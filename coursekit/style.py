@@ -35,6 +35,9 @@ def lecture_mode(on: bool = True) -> None:
     plotting helpers and explorers built after the call. ``lecture_mode(False)``
     restores the settings that were in force before it was switched on.
     """
+    if not isinstance(on, bool):
+        raise ValueError(f"on must be True or False: received {on!r}; "
+                         "call lecture_mode() to switch on, lecture_mode(False) to switch off.")
     import matplotlib as mpl
     global _saved
     if on:

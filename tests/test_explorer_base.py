@@ -1,0 +1,147 @@
+"""Explorer's static fallback (PNG next to the widget view) and lecture mode."""
+
+import base64
+import re
+
+import matplotlib as mpl
+import numpy as np
+import pytest
+
+import coursekit as ck
+from coursekit.explorers import Explorer, slider
+
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def _compute(a):
+    t = np.linspace(0.0, 5.0, 200)
+    return t, np.exp(-a * t) * np.cos(3.0 * t)
+
+
+def _draw(fig):
+    ax = fig.subplots()
+    line, = ax.plot([], [], label="y")
+    ax.set(title="demo", xlabel="t [s]", ylabel="y [m]")
+    return ax, line
+
+
+def _update(handles, result):
+    ax, line = handles
+    line.set_data(*result)
+    ax.relim()
+    ax.autoscale_view()
+
+
+def _explorer(a=1.0):
+    return Explorer(title="Demo", controls={"a": slider(a, 0.1, 3.0, 0.1, "a")},
+                    compute=_compute, draw=_draw, update=_update)
+
+
+@pytest.fixture(autouse=True)
+def _lecture_mode_off():
+    yield
+    ck.lecture_mode(False)
+
+
+def _png_size(png: bytes) -> tuple[int, int]:
+    # width and height are the first two big-endian ints of the IHDR chunk
+    return int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")
+
+
+def test_mimebundle_holds_the_widget_view_and_a_static_png():
+    exp = _explorer()
+    bundle = exp._repr_mimebundle_()
+    assert "application/vnd.jupyter.widget-view+json" in bundle
+    assert bundle["application/vnd.jupyter.widget-view+json"]["model_id"] == exp.widget.model_id
+    png = base64.b64decode(bundle["image/png"])
+    assert png.startswith(PNG_MAGIC)
+    assert bundle["text/plain"] == "Demo (static figure for a=1)"
+
+
+def test_moving_a_slider_refreshes_the_png_and_the_image_widget():
+    exp = _explorer()
+    widget = exp.widget
+    before = exp._png
+    exp.controls["a"].value = 2.5          # what a released slider does
+    assert exp.params == {"a": 2.5}
+    assert exp._png != before
+    assert widget.children[-1].value == exp._png
+    np.testing.assert_allclose(exp.handles[1].get_ydata(), _compute(2.5)[1])
+    assert base64.b64decode(exp._repr_mimebundle_()["image/png"]) == exp._png
+
+
+def test_lecture_mode_enlarges_explorer_figures_and_off_restores_defaults():
+    default = _png_size(_explorer()._png)
+    before = {key: mpl.rcParams[key] for key in ck.LECTURE_STYLE}
+    ck.lecture_mode()
+    assert ck.is_lecture_mode()
+    exp = _explorer()
+    assert tuple(exp.fig.get_size_inches()) == pytest.approx(ck.LECTURE_STYLE["figure.figsize"])
+    big = _png_size(exp._png)
+    assert big[0] > default[0] and big[1] > default[1]
+    fig, ax = ck.new_figure()
+    line, = ax.plot([0, 1], [0, 1])
+    assert line.get_linewidth() == ck.LECTURE_STYLE["lines.linewidth"]
+    assert ax.title.get_fontsize() == ck.LECTURE_STYLE["axes.titlesize"]
+    ck.lecture_mode()                       # switching on twice keeps the original defaults
+    ck.lecture_mode(False)
+    assert not ck.is_lecture_mode()
+    assert {key: mpl.rcParams[key] for key in ck.LECTURE_STYLE} == before
+    assert _png_size(_explorer()._png) == default
+
+
+def test_lecture_mode_off_without_on_changes_nothing():
+    before = dict(mpl.rcParams)
+    ck.lecture_mode(False)
+    assert dict(mpl.rcParams) == before
+
+
+def test_lecture_mode_rejects_a_non_bool():
+    with pytest.raises(ValueError, match="on must be True or False"):
+        ck.lecture_mode("yes")
+
+
+@pytest.fixture(scope="module")
+def executed_demo():
+    """A notebook with one explorer, executed once in a real kernel."""
+    nbformat = pytest.importorskip("nbformat")
+    pytest.importorskip("nbclient")
+    from nbclient import NotebookClient
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nb.cells = [nbformat.v4.new_code_cell(
+        "import numpy as np\nfrom coursekit.explorers import Explorer, slider\n"
+        "Explorer(title='Demo', controls={'a': slider(1.0, 0.1, 3.0, 0.1, 'a')},\n"
+        "         compute=lambda a: np.exp(-a * np.linspace(0, 5, 50)),\n"
+        "         draw=lambda fig: fig.subplots().plot([], [])[0],\n"
+        "         update=lambda line, y: line.set_data(np.arange(y.size), y))")]
+    NotebookClient(nb, timeout=120, kernel_name="python3").execute()
+    return nb
+
+
+def test_executed_notebook_output_carries_the_png_for_github_and_nbviewer(executed_demo):
+    data = executed_demo.cells[0].outputs[0]["data"]
+    assert "application/vnd.jupyter.widget-view+json" in data
+    assert base64.b64decode(data["image/png"]).startswith(PNG_MAGIC)
+
+
+def test_html_export_shows_the_png_without_a_widget_state(executed_demo):
+    import copy
+
+    from nbconvert import HTMLExporter
+    nb = copy.deepcopy(executed_demo)
+    nb.metadata.pop("widgets", None)
+    html, _ = HTMLExporter().from_notebook_node(nb)
+    assert re.search(r'<img[^>]+src="data:image/png;base64,', html)
+    assert "VBox(" not in html
+
+
+def test_html_export_with_widget_state_renders_the_image_widget(executed_demo):
+    from nbconvert import HTMLExporter
+    html, _ = HTMLExporter().from_notebook_node(executed_demo)
+    state = executed_demo.metadata["widgets"]["application/vnd.jupyter.widget-state+json"]["state"]
+    images = [m for m in state.values() if m["model_name"] == "ImageModel"]
+    # the embedded widget manager draws the Image widget from this stored PNG
+    assert len(images) == 1 and images[0]["buffers"][0]["path"] == ["value"]
+    assert base64.b64decode(images[0]["buffers"][0]["data"]).startswith(PNG_MAGIC)
+    assert "application/vnd.jupyter.widget-view+json" in html and "VBox(" not in html
