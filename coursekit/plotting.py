@@ -193,7 +193,7 @@ def plot_state_plane(trajectories, *, states=(0, 1), labels=None, state_names=No
     ax.axvline(0, color="0.6", linewidth=0.8)
     if equal_axes:
         ax.set_aspect("equal", adjustable="datalim")
-    ax.margins(0.15)
+    ax.margins(0.25)
     ax.grid(True, alpha=0.4)
     ax.legend(loc="best")
     ax.set_title(title)
