@@ -235,7 +235,7 @@ class OpenLoopPlan:
                 f"to xT = {self.xT.tolist()}; CCF a = {np.round(self.a, 6).tolist()}")
 
 
-def open_loop_control(A, B, x0, xT, T) -> OpenLoopPlan:
+def open_loop_control(A, B, x0, xT, T, *, smooth: int = 0) -> OpenLoopPlan:
     """Open-loop steering of x' = A x + B u from x0 to xT in time T (algorithm (2.73)).
 
     1. check controllability and compute the CCF transform z = T x (2.59)-(2.65)
@@ -245,6 +245,10 @@ def open_loop_control(A, B, x0, xT, T) -> OpenLoopPlan:
        y_d^(k)(0) = z0[k], y_d^(k)(T) = zT[k] (2.31)-(2.38);
     4. apply the feedforward u_d (2.25) with the CCF's a and b = 1.
 
+    ``smooth = s > 0`` adds s more boundary conditions, y_d^(n)..y_d^(n+s-1)
+    = 0 at both ends (degree 2(n + s) - 1): then u_d starts and ends at the
+    value a . z that holds an equilibrium, without a jump.
+
     Single input only. Returns an `OpenLoopPlan`.
     """
     A, B = _pair(A, B)
@@ -253,8 +257,12 @@ def open_loop_control(A, B, x0, xT, T) -> OpenLoopPlan:
     x0 = as_vector(x0, "x0", size=n, why=why)
     xT = as_vector(xT, "xT", size=n, why=why)
     horizon = as_scalar(T, "T", positive=True)
+    extra = as_scalar(smooth, "smooth", integer=True)
+    if extra < 0:
+        raise ValueError(f"smooth must be >= 0: received {smooth!r} (the number of extra zero derivatives).")
     Tz = ccf_transform(A, B)
     a = charpoly(A)
+    zeros = np.zeros(int(extra))
     # z0 = T x0, zT = T xT; in the CCF z = [z1, z1', ..., z1^(n-1)]
-    yd = poly_trajectory(horizon, Tz @ x0, Tz @ xT)
+    yd = poly_trajectory(horizon, np.concatenate([Tz @ x0, zeros]), np.concatenate([Tz @ xT, zeros]))
     return OpenLoopPlan(A, B, x0, xT, horizon, Tz, a, yd)

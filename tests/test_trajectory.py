@@ -133,6 +133,20 @@ def test_open_loop_steering_lands_on_the_target(n, seed):
     np.testing.assert_allclose(plan.x(0.0), x0, atol=1e-8 * size)
 
 
+def test_smooth_plan_starts_and_ends_at_the_holding_input():
+    A, B = [[0, 2], [1, -3]], [[1], [0]]
+    # xT = [3, 1] is an equilibrium for u = -2: 2*1 + (-2) = 0 and 3 - 3*1 = 0
+    plan = ck.open_loop_control(A, B, [0, 0], [3, 1], 3.0, smooth=1)
+    assert plan.yd.degree == 5
+    assert plan.ud(0.0) == pytest.approx(0.0, abs=1e-12)
+    assert plan.ud(3.0) == pytest.approx(-2.0)
+    assert plan.ud(10.0) == plan.ud(3.0)  # held after T
+    t = np.linspace(0, 6, 601)
+    res = ck.simulate(ck.StateSpace(A, B), t, u=plan.input)
+    np.testing.assert_allclose(res.x[300], [3, 1], atol=1e-7)
+    np.testing.assert_allclose(res.x[-1], [3, 1], atol=1e-5)  # unstable: tiny errors grow after T
+
+
 def test_open_loop_control_errors():
     with pytest.raises(ck.NotControllableError, match=r"rank 1 < n = 2"):
         # (2.1) with the corrected second line: x1 is not driven by u
@@ -143,3 +157,5 @@ def test_open_loop_control_errors():
         ck.open_loop_control([[0, 1], [0, 0]], [[0], [1]], [0, 0], [1, 1], -1.0)
     with pytest.raises(ValueError, match=r"B must have a single column"):
         ck.open_loop_control(np.eye(2), np.eye(2), [0, 0], [1, 1], 1.0)
+    with pytest.raises(ValueError, match=r"smooth must be >= 0"):
+        ck.open_loop_control([[0, 1], [0, 0]], [[0], [1]], [0, 0], [1, 1], 1.0, smooth=-1)
