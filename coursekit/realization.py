@@ -141,5 +141,5 @@ def euler_discretize(sys, Ts):
         # (1.43): f'(x, u) = x + Ts f(x, u)
         return np.asarray(x, dtype=float) + _Ts * _f(x, u)
 
-    return NonlinearSystem(f_euler, n=sys.n, m=sys.m, h=sys._h, dt=Ts, name=name,
+    return NonlinearSystem(f_euler, n=sys.n, m=sys.m, h=sys.h, dt=Ts, name=name,
                            params=dict(sys.params, Ts=Ts))
