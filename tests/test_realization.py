@@ -79,9 +79,9 @@ def test_realization_matches_python_control(a, data):
     sys = ck.ode_to_ss(a, b)
     ref = control.tf(b[::-1], np.r_[1.0, a[::-1]])
     for s in (0.3 + 1.1j, 2.0j, -0.7 + 0.2j):
+        # skip an s that is (nearly) a pole, where both sides are infinite
+        assume(abs(np.polyval(np.r_[1.0, a[::-1]], s)) > 1e-3)
         mine = (sys.C @ np.linalg.solve(s * np.eye(n) - sys.A, sys.B))[0, 0]
-        den = np.polyval(np.r_[1.0, a[::-1]], s)
-        assume(abs(den) > 1e-3)
         assert np.isclose(mine, ref(s), rtol=1e-7, atol=1e-9)
 
 
