@@ -269,6 +269,8 @@ class FlatPlan:
         self.flat = flat
         self.horizon = horizon
         self.trajectories = trajectories
+        # smallest planned speed |F'| on [0, T], set by plan_robot
+        self.min_speed = None
 
     def _clip(self, t):
         tt = as_vector(t, "t")

@@ -211,11 +211,10 @@ def symbolic_flat_maps(system: str, **params) -> SymbolicFlatMaps:
         name, derivs, psi_x, psi_u = _pendulum()
     else:
         name, derivs, psi_x, psi_u = _planar(car=system == "car_like")
-    known = {s.name: s for s in (psi_x.free_symbols | psi_u.free_symbols)}
+    flat_symbols = {s for row in derivs for s in row}
+    known = {s.name: s for s in (psi_x.free_symbols | psi_u.free_symbols) - flat_symbols}
     for key, value in params.items():
-        if key not in known and not any(key == s.name for row in derivs for s in row):
-            allowed = sorted(k for k in known if not k.startswith("F"))
-            raise ValueError(f"{key} is not a parameter of the {name}: expected one of {allowed}.")
-        if key in known:
-            psi_x, psi_u = psi_x.subs(known[key], value), psi_u.subs(known[key], value)
+        if key not in known:
+            raise ValueError(f"{key} is not a parameter of the {name}: expected one of {sorted(known)}.")
+        psi_x, psi_u = psi_x.subs(known[key], value), psi_u.subs(known[key], value)
     return SymbolicFlatMaps(name, derivs, sp.Matrix(psi_x), sp.Matrix(psi_u))

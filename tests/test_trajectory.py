@@ -126,6 +126,12 @@ def test_open_loop_steering_lands_on_the_target(n, seed):
     if np.linalg.cond(ck.ctrb(A, B)) > 1e6:
         return
     plan = ck.open_loop_control(A, B, x0, xT, T=1.5)
+    # the plan's transform gives the CCF (2.72) with last row -a
+    ccf = ck.similarity_transform(ck.StateSpace(A, B), plan.transform)
+    expected = np.eye(n, k=1)
+    expected[-1] = -plan.a
+    np.testing.assert_allclose(ccf.A, expected, atol=1e-7 * (1 + np.abs(expected).max()))
+    np.testing.assert_allclose(ccf.B[:, 0], np.eye(n)[-1], atol=1e-8)
     t = np.linspace(0, 1.5, 151)
     res = ck.simulate(ck.StateSpace(A, B), t, u=plan.input, x0=x0)
     size = 1 + np.abs(plan.x(t)).max()
