@@ -31,7 +31,11 @@ def test_single_input_matches_python_control_with_flipped_sign(n, seed):
         return
     poles = -np.linspace(1, 2.5, n)
     K = ck.place(A, B, poles)
-    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A + B @ K)), sorted_eig(poles), atol=1e-5)
+    # poles 0.2 apart at n = 8 are sensitive: eig(A + B K) moves by ~1e-4 even for a K exact to
+    # 1e-14 (checked against a 60-digit oracle), so check the characteristic polynomial instead
+    p = ck.poly_from_roots(poles)
+    np.testing.assert_allclose(ck.charpoly(A + B @ K), p, rtol=1e-6, atol=1e-6 * np.abs(p).max())
+    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A + B @ K)), sorted_eig(poles), atol=1e-2)
     K_ref = -np.atleast_2d(control.acker(A, B, poles))
     np.testing.assert_allclose(K, K_ref, rtol=1e-6, atol=1e-8 * np.abs(K_ref).max())
 

@@ -234,7 +234,7 @@ def integral_action_explorer() -> Explorer:
         uplain, = ax_u.plot([], [], color="C0", label="u = K x")
         uint, = ax_u.plot([], [], color="C2", label="u = K x + k_I int x1")
         ax_u.set(xlabel="time t [s]", ylabel="control input u", title="control input (integral action ends at u = -d)")
-        ax_u.legend(loc="upper right")
+        ax_u.legend(loc="upper left")
         for ax in (ax_y, ax_u):
             ax.grid(True, alpha=0.4)
         return dict(ax_y=ax_y, ax_u=ax_u, plain=plain, integ=integ, off=off, uplain=uplain, uint=uint)
