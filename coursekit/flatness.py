@@ -30,7 +30,7 @@ import numpy as np
 
 from ._validation import as_matrix, as_scalar, as_vector
 from .controllability import _pair, ccf_transform, charpoly
-from .trajectory import poly_trajectory
+from .trajectory import plot_plan, poly_trajectory
 
 __all__ = [
     "FlatSystem",
@@ -304,6 +304,11 @@ class FlatPlan:
         columns = [traj._scalar_derivatives(tt, self.flat.order_u) for traj in self.trajectories]
         D = [np.array([[col[k] for col in columns]]) for k in range(self.flat.order_u + 1)]
         return self.flat._psi_u(D)[0]
+
+    def plot(self, samples: int = 301):
+        """Figure of the planned state psi_x and input psi_u on [0, T]; returns the figure."""
+        t = np.linspace(0.0, self.horizon, int(as_scalar(samples, "samples", positive=True, integer=True)))
+        return plot_plan(t, self.x(t), self.u(t), title=f"flat plan for the {self.flat.name} (2.88)-(2.89)")
 
     @property
     def x0(self) -> np.ndarray:

@@ -20,7 +20,8 @@ import numpy as np
 from ._validation import as_scalar, as_vector
 from .controllability import _pair, ccf_transform, charpoly
 
-__all__ = ["PolyTrajectory", "poly_trajectory", "feedforward", "OpenLoopPlan", "open_loop_control"]
+__all__ = ["PolyTrajectory", "poly_trajectory", "feedforward", "OpenLoopPlan", "open_loop_control",
+           "plot_plan"]
 
 
 def _times(t, name: str = "t"):
@@ -126,6 +127,8 @@ def poly_trajectory(T, start, end) -> PolyTrajectory:
     end = as_vector(end, "end", size=start.size,
                     why="the same number of boundary conditions at t = 0 and t = T")
     r = start.size
+    if r == 0:
+        raise ValueError("start is empty: expected at least the value y(0) (and its derivatives).")
     # d^k y/dt^k = (2/T)^k d^k p/ds^k, so the s-derivatives are (T/2)^k times the t-derivatives
     scale = (T / 2.0) ** np.arange(r)
     coeffs = _hermite_coefficients(r, start * scale, end * scale)
@@ -230,9 +233,32 @@ class OpenLoopPlan:
         """``u(t, x)`` for `simulate`: the open-loop input ignores x."""
         return np.array([self.ud(t)])
 
+    def plot(self, samples: int = 301):
+        """Figure of the planned states x(t) and the input u_d(t) on [0, T]; returns the figure."""
+        t = np.linspace(0.0, self.horizon, int(as_scalar(samples, "samples", positive=True, integer=True)))
+        return plot_plan(t, self.x(t), self.ud(t).reshape(-1, 1),
+                         title=f"open-loop plan (2.73) from x0 = {self.x0.tolist()} to xT = {self.xT.tolist()}")
+
     def __repr__(self) -> str:
         return (f"OpenLoopPlan over [0, {self.horizon:g}] from x0 = {self.x0.tolist()} "
                 f"to xT = {self.xT.tolist()}; CCF a = {np.round(self.a, 6).tolist()}")
+
+
+def plot_plan(t, x, u, *, title: str):
+    """Two panels: planned states and planned inputs against time (used by the plan objects)."""
+    from .style import new_figure
+    fig, (ax_x, ax_u) = new_figure(1, 2, figsize=(10, 3.6))
+    for i in range(x.shape[1]):
+        ax_x.plot(t, x[:, i], label=f"x{i + 1}")
+    for j in range(u.shape[1]):
+        ax_u.plot(t, u[:, j], label=f"u{j + 1}" if u.shape[1] > 1 else "u_d")
+    ax_x.set(title="planned state", xlabel="time t [s]", ylabel="state x [units of x]")
+    ax_u.set(title="planned input", xlabel="time t [s]", ylabel="input u [units of u]")
+    for ax in (ax_x, ax_u):
+        ax.grid(True, alpha=0.4)
+        ax.legend()
+    fig.suptitle(title)
+    return fig
 
 
 def open_loop_control(A, B, x0, xT, T, *, smooth: int = 0) -> OpenLoopPlan:

@@ -75,6 +75,8 @@ def test_robot_manoeuvres_are_driven_by_the_nonlinear_models(L, speed):
     np.testing.assert_allclose(np.cos(res.x[-1, 2] - end[2]), 1.0, atol=1e-9)
     assert np.sign(plan.u(3.0)[0]) == np.sign(speed)
     assert plan.min_speed > 0
+    fig = plan.plot(samples=50)
+    assert len(fig.axes[0].lines) == 3 and len(fig.axes[1].lines) == 2
 
 
 def test_two_wheeled_psi_matches_2_97_and_2_102():

@@ -63,6 +63,8 @@ def test_poly_trajectory_bad_input():
         ck.poly_trajectory(0.0, [0, 0], [1, 0])
     with pytest.raises(ValueError, match=r"end has the wrong length: received 1 entries, expected 2"):
         ck.poly_trajectory(1.0, [0, 0], [1])
+    with pytest.raises(ValueError, match=r"start is empty"):
+        ck.poly_trajectory(1.0, [], [])
     with pytest.raises(ValueError, match=r"start contains NaN"):
         ck.poly_trajectory(1.0, [np.nan, 0], [1, 0])
     traj = ck.poly_trajectory(1.0, [0, 0], [1, 0])
@@ -112,6 +114,10 @@ def test_example_2_66_end_to_end():
     # in the z-coordinates the planned state is (y_d, y_d')
     np.testing.assert_allclose(plan.z(t)[:, 1], plan.yd(t, 1))
     assert "OpenLoopPlan" in repr(plan)
+    fig = plan.plot()
+    ax_x, ax_u = fig.axes
+    np.testing.assert_allclose(ax_x.lines[0].get_ydata()[[0, -1]], [1.0, 0.0], atol=1e-12)
+    assert ax_u.get_xlabel() == "time t [s]" and fig._suptitle.get_text().startswith("open-loop plan")
 
 
 @given(n=st.integers(1, 4), seed=st.integers(0, 10_000))
