@@ -167,13 +167,42 @@ def _records(t, u, y, m: int):
     return t, u, y
 
 
-def _riccati_rate(A, P, CtRiC) -> float:
-    """A bound on how fast (4.88) moves, to choose the RK4 step."""
-    return float(np.linalg.norm(A) + np.linalg.norm(P) * np.linalg.norm(CtRiC))
+def _riccati_rate(A: np.ndarray, L: np.ndarray, C: np.ndarray) -> float:
+    """How fast (4.88) moves near P: its linearization is dP' = (A - L C) dP + dP (A - L C)^T,
+    whose eigenvalues are sums of two eigenvalues of A - L C."""
+    return 2.0 * float(np.abs(np.linalg.eigvals(A - L @ C)).max())
 
 
 def _lerp(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
     return a + s * (b - a)
+
+
+def _rk4_interval(rhs, x, P, cur, u0, u1, y0, y1, dt: float, substeps: int):
+    """RK4 from one sample to the next, with u and y linear in between.
+
+    The step is at most dt / substeps and at most 0.5 / rate, the rate of
+    (4.88) at the current P, so a fast start (large P0, small R) takes many
+    short steps that lengthen as P settles. `cur` is rhs at the start; the
+    value at the end is returned for the next interval.
+    """
+    tau = 0.0
+    while tau < dt:
+        _, _, L, A, C = cur
+        h = min(dt - tau, dt / substeps, 0.5 / max(_riccati_rate(A, L, C), 1e-300))
+        if dt - tau - h < 1e-9 * dt:
+            h = dt - tau
+        um, ue = _lerp(u0, u1, (tau + h / 2) / dt), _lerp(u0, u1, (tau + h) / dt)
+        ym, ye = _lerp(y0, y1, (tau + h / 2) / dt), _lerp(y0, y1, (tau + h) / dt)
+        k1 = cur[:2]
+        k2 = rhs(x + h / 2 * k1[0], P + h / 2 * k1[1], um, ym)[:2]
+        k3 = rhs(x + h / 2 * k2[0], P + h / 2 * k2[1], um, ym)[:2]
+        k4 = rhs(x + h * k3[0], P + h * k3[1], ue, ye)[:2]
+        x = x + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
+        P = P + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        P = (P + P.T) / 2
+        tau = dt if h == dt - tau else tau + h
+        cur = rhs(x, P, ue, ye)
+    return x, P, cur
 
 
 def _run_filter(f, h, dfdx, dhdx, t, u, y, Q, R, P0, x0, substeps: int) -> KalmanResult:
@@ -193,26 +222,13 @@ def _run_filter(f, h, dfdx, dhdx, t, u, y, Q, R, P0, x0, substeps: int) -> Kalma
 
     xs, Ps, Ls = np.empty((N, n)), np.empty((N, n, n)), np.empty((N, n, y.shape[1]))
     x, P = x0.copy(), P0.copy()
+    cur = rhs(x, P, u[0], y[0])
     for k in range(N):
-        dx0, dP0, L, A, C = rhs(x, P, u[k], y[k])
-        xs[k], Ps[k], Ls[k] = x, P, L
+        xs[k], Ps[k], Ls[k] = x, P, cur[2]
         if k + 1 == N:
             break
-        dt = t[k + 1] - t[k]
-        # steps of at most 0.5 / rate keep RK4 accurate on the fast part of (4.88)
-        pieces = max(substeps, int(np.ceil(2 * dt * _riccati_rate(A, P, C.T @ Rinv @ C))))
-        h_ = dt / pieces
-        for j in range(pieces):
-            s0, sm, s1 = j / pieces, (j + 0.5) / pieces, (j + 1) / pieces
-            u0, um, u1 = (_lerp(u[k], u[k + 1], s) for s in (s0, sm, s1))
-            y0, ym, y1 = (_lerp(y[k], y[k + 1], s) for s in (s0, sm, s1))
-            k1 = (dx0, dP0) if j == 0 else rhs(x, P, u0, y0)[:2]
-            k2 = rhs(x + h_ / 2 * k1[0], P + h_ / 2 * k1[1], um, ym)[:2]
-            k3 = rhs(x + h_ / 2 * k2[0], P + h_ / 2 * k2[1], um, ym)[:2]
-            k4 = rhs(x + h_ * k3[0], P + h_ * k3[1], u1, y1)[:2]
-            x = x + h_ / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-            P = P + h_ / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
-            P = (P + P.T) / 2
+        x, P, cur = _rk4_interval(rhs, x, P, cur, u[k], u[k + 1], y[k], y[k + 1],
+                                  t[k + 1] - t[k], substeps)
         if not (np.all(np.isfinite(x)) and np.all(np.isfinite(P))):
             raise RuntimeError(
                 f"the filter diverged at t={t[k + 1]:g} (non-finite estimate or P); check the "
