@@ -147,7 +147,7 @@ def upright_pendulum_compute(theta0_deg: float = 30.0, pole: float = -2.0, u_max
     t = np.linspace(0.0, as_scalar(t_end, "t_end", positive=True), int(samples))
     out = dict(t=t, K=K, theta0_deg=float(np.rad2deg(theta0)), u_max=u_max)
     for name, ctrl in controllers.items():
-        res = simulate(P, t, u=_saturated(ctrl, u_max), x0=[np.pi - theta0, 0.0], rtol=1e-7, atol=1e-9)
+        res = simulate(P, t, u=_saturated(ctrl, u_max), x0=[np.pi - theta0, 0.0], rtol=1e-6, atol=1e-8)
         dev = np.rad2deg(res.x[:, 0] - np.pi)
         out[f"dev_{name}"], out[f"u_{name}"] = dev, res.u[:, 0]
         wrapped = (dev[-1] + 180.0) % 360.0 - 180.0
