@@ -38,7 +38,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_square, as_time_grid, as_vector, is_uniform
+from ._validation import as_matrix, as_scalar, as_square, as_time_grid, as_vector, is_uniform
 from .observability import _obs_pair
 from .simulation import SimulationResult, lti_step_matrices
 from .systems import NonlinearSystem, StateSpace
@@ -173,6 +173,9 @@ def _riccati_rate(A: np.ndarray, L: np.ndarray, C: np.ndarray) -> float:
     return 2.0 * float(np.abs(np.linalg.eigvals(A - L @ C)).max())
 
 
+_MAX_STEPS = 100_000
+
+
 def _lerp(a: np.ndarray, b: np.ndarray, s: float) -> np.ndarray:
     return a + s * (b - a)
 
@@ -185,7 +188,7 @@ def _rk4_interval(rhs, x, P, cur, u0, u1, y0, y1, dt: float, substeps: int):
     short steps that lengthen as P settles. `cur` is rhs at the start; the
     value at the end is returned for the next interval.
     """
-    tau = 0.0
+    tau, steps = 0.0, 0
     while tau < dt:
         _, _, L, A, C = cur
         h = min(dt - tau, dt / substeps, 0.5 / max(_riccati_rate(A, L, C), 1e-300))
@@ -200,6 +203,14 @@ def _rk4_interval(rhs, x, P, cur, u0, u1, y0, y1, dt: float, substeps: int):
         x = x + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
         P = P + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
         P = (P + P.T) / 2
+        if not (np.all(np.isfinite(x)) and np.all(np.isfinite(P))):
+            break                                   # the caller reports the divergence
+        steps += 1
+        if steps > _MAX_STEPS:
+            raise RuntimeError(
+                f"the Riccati equation (4.88) needs more than {_MAX_STEPS} RK4 steps between two "
+                "samples (its rate is huge): check the units of Q and R (module docstring), or "
+                "start from a smaller P0.")
         tau = dt if h == dt - tau else tau + h
         cur = rhs(x, P, ue, ye)
     return x, P, cur
@@ -236,6 +247,10 @@ def _run_filter(f, h, dfdx, dhdx, t, u, y, Q, R, P0, x0, substeps: int) -> Kalma
     return KalmanResult(t=t, x=xs, P=Ps, L=Ls)
 
 
+def _substeps(substeps) -> int:
+    return int(as_scalar(substeps, "substeps", positive=True, integer=True))
+
+
 def _filter_setup(n: int, p: int, Q, R, P0, x0):
     Q = _covariance(Q, "Q", n, definite=False)
     R = _covariance(R, "R", p, definite=True)
@@ -268,7 +283,7 @@ def kalman_bucy(sys, t, u, y, Q, R, P0, x0, *, substeps: int = 1) -> KalmanResul
     A, B, C, D = sys.A, sys.B, sys.C, sys.D
     return _run_filter(lambda x, v: A @ x + B @ v, lambda x, v: C @ x + D @ v,
                        lambda x, v: A, lambda x, v: C, t, u, y, Q, R, P0, x0,
-                       int(max(1, substeps)))
+                       _substeps(substeps))
 
 
 def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None = None,
@@ -303,7 +318,7 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
         (lambda x, v: _jacobian(sys.f, x, v))
     jh = (lambda x, v: np.asarray(dhdx(x, v), float).reshape(p_h, sys.n)) if dhdx else \
         (lambda x, v: _jacobian(sys.h, x, v))
-    return _run_filter(sys.f, sys.h, jf, jh, t, u, y, Q, R, P0, x0, int(max(1, substeps)))
+    return _run_filter(sys.f, sys.h, jf, jh, t, u, y, Q, R, P0, x0, _substeps(substeps))
 
 
 def _rng(seed) -> np.random.Generator:

@@ -201,6 +201,8 @@ def test_filter_bad_inputs():
     with pytest.raises(ValueError, match=r"y has the wrong number of columns: received 2, expected 1"):
         ck.extended_kalman_filter(ck.models.pendulum(), t, None, np.zeros((11, 2)), Q,
                                   np.eye(2), np.eye(2), [0, 0])
+    with pytest.raises(ValueError, match=r"substeps must be positive"):
+        ck.kalman_bucy(sys, t, None, np.zeros((11, 1)), Q, R, np.eye(2), [0, 0], substeps=0)
     with pytest.raises(ValueError, match=r"dfdx must be a function"):
         ck.extended_kalman_filter(ck.models.pendulum(), t, None, np.zeros((11, 1)), Q, R,
                                   np.eye(2), [0, 0], dfdx=np.eye(2))
