@@ -221,13 +221,14 @@ def integral_closed_loop(A, B, K_E, C=None, *, integrators: int = 1) -> StateSpa
     d = d0 t (3.132) included.
     """
     A_E, B_E = integral_augment(A, B, C, integrators=integrators)
+    q = _integrators(integrators)
     n = as_square(A, "A").shape[0]
     C = _output_matrix(C, n)
     p, m, N = C.shape[0], B_E.shape[1], A_E.shape[0]
     K_E = as_matrix(K_E, "K_E", rows=m, cols=N, rows_why="one per input",
                     cols_why="one per augmented state (integrators first)")
     B_r = np.zeros((N, p))
-    B_r[(integrators - 1) * p:integrators * p] = -np.eye(p)
+    B_r[(q - 1) * p:q * p] = -np.eye(p)
     C_E = np.hstack([np.zeros((p, N - n)), C])
     # x_E' = (A_E + B_E K_E) x_E + B_E d - [0; I; 0] r
     return StateSpace(A_E + B_E @ K_E, np.hstack([B_E, B_r]), C_E, name="integral action loop")
