@@ -34,6 +34,27 @@ def test_symbolic_linear_flatness_of_2_80():
     assert sp.expand(maps.psi_u[0] - (-2 * F0 + 3 * F1 + F2)) == 0
 
 
+def test_symbolic_flat_output_of_the_mass_spring_damper_is_m_y():
+    A, B = ck.symbolic_mass_spring_damper()
+    maps = ck.symbolic_linear_flatness(A, B)
+    m, d, k = sp.symbols("m d k", positive=True)
+    assert maps.T1 == sp.Matrix([[m, 0]])
+    # numerically the same as linear_flatness for m = 2, d = 0.5, k = 3
+    sys = ck.models.mass_spring_damper(m=2.0, d=0.5, k=3.0)
+    flat = ck.linear_flatness(sys.A, sys.B)
+    np.testing.assert_allclose(flat.T1, [2.0, 0.0])
+    fx, fu = _maps_at(maps, {m: 2.0, d: 0.5, k: 3.0})
+    probe = [0.3, -0.2, 1.1]
+    np.testing.assert_allclose(fx(probe), flat.psi_x(probe))
+    np.testing.assert_allclose(fu(probe), flat.psi_u(probe))
+
+
+def _maps_at(maps, values):
+    """The maps with parameter values substituted, as numerical functions."""
+    fixed = ck.SymbolicFlatMaps(maps.name, maps.derivs, maps.psi_x.subs(values), maps.psi_u.subs(values))
+    return fixed.functions()
+
+
 @pytest.mark.parametrize("system, params, flat", [
     ("pendulum", dict(m=1.5, l=0.8, g=9.81, d_theta=0.3),
      lambda: ck.pendulum_flatness(m=1.5, l=0.8, g=9.81, d_theta=0.3)),
