@@ -237,35 +237,66 @@ def _move_first_slider(page) -> None:
 
 
 def _open_notebook(page, lab: str, name: str) -> None:
-    page.goto(f"{lab}/lab/tree/{name}?token={TOKEN}")
-    page.wait_for_selector(".jp-NotebookPanel .jp-Cell", timeout=60_000)
+    # a fresh workspace per notebook (?reset), so no tab of an earlier test is restored
+    workspace = re.sub(r"\W", "-", name)
+    page.goto(f"{lab}/lab/workspaces/{workspace}/tree/{name}?reset&token={TOKEN}")
+    page.wait_for_selector(".jp-NotebookPanel:not(.lm-mod-hidden) .jp-Cell", timeout=60_000)
     # the kernel is ready when the status bar says "Python 3 (ipykernel) | Idle"
     page.wait_for_function("() => /\\|\\s*Idle/.test(document.querySelector('#jp-main-statusbar')"
                            "?.textContent || '')", timeout=90_000)
 
 
 @pytest.mark.parametrize("name", ["demo_explorer.ipynb", *_chapter_notebooks()])
-def test_notebook_runs_in_jupyterlab_and_its_explorer_answers(name, lab, browser, capsys):
+def test_notebook_runs_in_jupyterlab_and_its_explorer_answers(name, lab, browser, capsys, tmp_path):
     page = browser.new_page(viewport={"width": 1400, "height": 1000})
     try:
-        t0 = time.monotonic()
-        _open_notebook(page, lab, name)
-        t_open = time.monotonic() - t0
-        _run_all(page)
-        prompts = _wait_until_done(page, RUN_TIMEOUT_S)
-        t_run = time.monotonic() - t0 - t_open
-        errors = page.evaluate(_ERRORS_JS)
-        assert not errors, f"{name}: a cell shows an error:\n" + "\n----\n".join(errors)
-        not_run = [i for i, p in enumerate(prompts) if not _executed(p)]
-        assert not not_run, f"{name}: code cells {not_run} did not run (prompts {prompts})"
-        images = page.evaluate(_EXPLORER_IMAGES_JS)
-        assert images, f"{name}: no explorer figure (a widget with an image) was rendered"
-        t1 = time.monotonic()
-        _move_first_slider(page)
-        _wait_for_new_image(page, 0, images[0], SLIDER_TIMEOUT_S)
-        t_slider = time.monotonic() - t1
-        with capsys.disabled():
-            print(f"\n[browser] {name}: open {t_open:.1f} s, run all {t_run:.1f} s "
-                  f"({len(prompts)} code cells), slider -> new figure {t_slider:.1f} s")
+        _check_notebook(page, name, lab, capsys)
+    except BaseException:
+        shot = tmp_path / f"{name}.png"
+        page.screenshot(path=str(shot), full_page=True)
+        print(f"screenshot of the failing page: {shot}")
+        raise
     finally:
         page.close()
+        _shut_down_kernels(lab)
+
+
+def _check_notebook(page, name: str, lab: str, capsys) -> None:
+    """Open, run all, look for errors, move a slider; print the timings."""
+    t0 = time.monotonic()
+    _open_notebook(page, lab, name)
+    t_open = time.monotonic() - t0
+    _run_all(page)
+    prompts = _wait_until_done(page, RUN_TIMEOUT_S)
+    t_run = time.monotonic() - t0 - t_open
+    errors = page.evaluate(_ERRORS_JS)
+    assert not errors, f"{name}: a cell shows an error:\n" + "\n----\n".join(errors)
+    assert len(prompts) == _count_code_cells(name), (
+        f"{name}: {len(prompts)} code cells rendered, the notebook has {_count_code_cells(name)}")
+    not_run = [i for i, p in enumerate(prompts) if not _executed(p)]
+    assert not not_run, f"{name}: code cells {not_run} did not run (prompts {prompts})"
+    images = page.evaluate(_EXPLORER_IMAGES_JS)
+    assert images, f"{name}: no explorer figure (a widget with an image) was rendered"
+    t1 = time.monotonic()
+    _move_first_slider(page)
+    _wait_for_new_image(page, 0, images[0], SLIDER_TIMEOUT_S)
+    t_slider = time.monotonic() - t1
+    with capsys.disabled():
+        print(f"\n[browser] {name}: open {t_open:.1f} s, run all {t_run:.1f} s "
+              f"({len(prompts)} code cells), slider -> new figure {t_slider:.1f} s")
+
+
+def _count_code_cells(name: str) -> int:
+    if name == "demo_explorer.ipynb":
+        return len(DEMO_SOURCE)
+    cells = json.loads((NOTEBOOKS / name).read_text(encoding="utf-8"))["cells"]
+    return sum(cell["cell_type"] == "code" for cell in cells)
+
+
+def _shut_down_kernels(lab: str) -> None:
+    """Stop every kernel of the server so the next notebook has the machine to itself."""
+    with urllib.request.urlopen(f"{lab}/api/kernels?token={TOKEN}", timeout=10) as response:
+        kernels = json.load(response)
+    for kernel in kernels:
+        request = urllib.request.Request(f"{lab}/api/kernels/{kernel['id']}?token={TOKEN}", method="DELETE")
+        urllib.request.urlopen(request, timeout=30).close()
