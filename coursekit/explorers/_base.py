@@ -13,6 +13,12 @@ an image widget. It also carries a static PNG of the figure in its display
 data, so a renderer without a live widget front-end (GitHub, nbviewer, an
 exported HTML) shows the figure for the default parameters instead of a bare
 widget repr.
+
+Exported HTML: ``jupyter nbconvert --to html --execute`` stores the widget
+state, and the page's embedded widget manager (loaded from unpkg.com) draws
+the widget with the figure from that state; with
+``--ExecutePreprocessor.store_widget_state=False`` the page shows the static
+PNG as a plain image, which also works offline.
 """
 
 from __future__ import annotations
