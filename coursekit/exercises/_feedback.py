@@ -194,11 +194,13 @@ def matrix_feedback(answer, expected, name: str, report: Report, *,
     wrong = ~close(arr, expected)
     flipped = wrong & close(-arr, expected)
     other = wrong & ~flipped
+    parts = []
     if flipped.any():
-        report.add(f"{name}: {_at(flipped)} the wrong sign. {entry_hint}".strip())
+        parts.append(f"{_at(flipped)} the wrong sign")
     if other.any():
-        report.add(f"{name}: {_at(other).replace(' has', ' is').replace(' have', ' are')} off "
-                   f"(counted from 1). {entry_hint}".strip())
+        parts.append(f"{_at(other).replace(' has', ' is').replace(' have', ' are')} off")
+    # positions are counted from 1, as the notes index matrices; the hint is given once
+    report.add(f"{name}: {' and '.join(parts)} (counted from 1). {entry_hint}".strip())
     return False
 
 

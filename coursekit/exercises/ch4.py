@@ -79,7 +79,8 @@ def check_observer_gain(L) -> bool:
         (-L_ok, "L has the wrong sign: the course's estimation error obeys e' = (A - L C) e (4.27); "
                 "you placed the eigenvalues of A + L C."),
     ], shape_hint="L must be a column (n x p) (one column per measurement).",
-        entry_hint="Write det(sI - (A - L C)) with L = [l1; l2] and match it with (s + 5)(s + 6).")
+        entry_hint="Write det(sI - (A - L C)) with L = [l1; l2] and match it with "
+                   + "".join(f"(s {'+' if p < 0 else '-'} {abs(p):g})" for p in OBSERVER["poles"]) + ".")
     if not ok and len(report.problems) == 1 and "off" in report.problems[0]:
         try:
             Lst = np.asarray(L, dtype=float).reshape(L_ok.shape)
