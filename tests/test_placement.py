@@ -128,9 +128,12 @@ def test_repeated_pole_single_input(n, seed, pole):
         return
     A, B = pair
     K = ck.place(A, B, [pole] * n)
-    # a pole of multiplicity n is sensitive (error ~ eps^(1/n)): check the polynomial instead
-    np.testing.assert_allclose(ck.charpoly(A + B @ K), np.poly([pole] * n)[::-1][:-1],
-                               rtol=1e-6, atol=1e-6 * abs(pole) ** n)
+    # a pole of multiplicity n is sensitive (computed eigenvalues scatter by ~eps^(1/n)), so
+    # compare K with the oracle and the characteristic polynomial with a loose tolerance
+    K_ref = _high_precision_gain(A, B, [pole] * n)
+    np.testing.assert_allclose(K, K_ref, rtol=1e-6, atol=1e-6 * np.abs(K_ref).max())
+    p = np.poly([pole] * n)[::-1][:-1]
+    np.testing.assert_allclose(ck.charpoly(A + B @ K), p, rtol=1e-4, atol=1e-4 * np.abs(p).max())
 
 
 @given(st.integers(2, 5), st.integers(2, 3), st.integers(0, 10_000))
