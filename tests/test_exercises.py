@@ -298,3 +298,9 @@ def test_leak_detector_sees_numbers_but_not_equation_references():
     assert {"-9", "-6", "0.5"} <= _numbers_in("K = [[-9, -6]], T = [[0.5, 0]]")
     assert _numbers_in("see (3.47) and section 2.2.3; entries (2, 1); A^2 B is 3 x 3") == set()
     assert "-9" in _solution_numbers("check_gain_general")
+
+
+def test_every_checker_has_wrong_answer_cases():
+    checkers = {n for n in ex.__all__ if n.startswith("check_")}
+    assert len(checkers) == 18
+    assert checkers == {case[0] for case in WRONG}
