@@ -304,3 +304,35 @@ def test_every_checker_has_wrong_answer_cases():
     checkers = {n for n in ex.__all__ if n.startswith("check_")}
     assert len(checkers) == 18
     assert checkers == {case[0] for case in WRONG}
+
+
+from hypothesis import given, strategies as st  # noqa: E402
+from hypothesis.extra.numpy import arrays  # noqa: E402
+
+from coursekit.exercises._feedback import Report, matrix_feedback  # noqa: E402
+
+_entries = st.floats(-50, 50, allow_nan=False).filter(lambda v: abs(v) > 0.5).map(lambda v: round(v, 2))
+
+
+@given(expected=st.integers(2, 4).flatmap(lambda n: arrays(float, (n, n), elements=_entries)),
+       data=st.data())
+def test_feedback_names_the_one_changed_entry(expected, data):
+    n = expected.shape[0]
+    i, j = data.draw(st.integers(0, n - 1)), data.draw(st.integers(0, n - 1))
+    answer = expected.copy()
+    answer[i, j] += data.draw(st.sampled_from([1.0, -2.5, 10.0]))
+    report = Report("t")
+    assert matrix_feedback(expected.copy(), expected, "M", report) and report.ok
+    assert not matrix_feedback(answer, expected, "M", report)
+    message = report.problems[-1]
+    if "transposed" not in message:
+        assert f"({i + 1}, {j + 1})" in message
+
+
+@given(expected=arrays(float, (3, 1), elements=_entries))
+def test_feedback_flags_a_whole_sign_flip_and_a_transposed_column(expected):
+    report = Report("t")
+    assert not matrix_feedback(-expected, expected, "B", report)
+    assert "opposite sign in every entry" in report.problems[-1]
+    assert not matrix_feedback(expected.T, expected, "B", report)
+    assert "transposed" in report.problems[-1] and "column (3 x 1)" in report.problems[-1]
