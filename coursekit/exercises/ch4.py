@@ -10,7 +10,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..placement import place
+from ..observability import obsv, place_observer
+from ..observers import separation_eigenvalues
+from ..systems import StateSpace
 from ._feedback import Report, matrix_feedback, poles_feedback, rank_decision_feedback, read_poles
 
 __all__ = [
@@ -34,19 +36,11 @@ SEPARATION = {"A": ((0.0, 1.0), (3.0, -2.0)), "B": ((0.0,), (1.0,)), "C": ((1.0,
               "K": ((-9.0, -3.0),), "L": ((7.0,), (9.0,))}
 
 
-def _obsv(A: np.ndarray, C: np.ndarray) -> np.ndarray:
-    rows = [C]
-    for _ in range(A.shape[0] - 1):
-        rows.append(rows[-1] @ A)
-    # (4.15): Wo = [C; CA; ...; CA^(n-1)]
-    return np.vstack(rows)
-
-
 def check_obsv_matrix(Wo) -> bool:
     """Check the observability matrix Wo = [C; CA; CA^2] of `OBSV` (4.15)."""
     report = Report("observability matrix")
     A, C = np.array(OBSV["A"]), np.array(OBSV["C"])
-    Wo_ok = _obsv(A, C)
+    Wo_ok = obsv(A, C)   # (4.15): Wo = [C; CA; CA^2]
     matrix_feedback(Wo, Wo_ok, "Wo", report, known_mistakes=[
         (Wo_ok[::-1], "Wo: the rows are in reverse order: C on top, then CA, then CA^2 (4.15)."),
         (np.vstack([C, (A @ C.T).T, (A @ A @ C.T).T]),
@@ -60,7 +54,7 @@ def check_vehicle_observability(rank, observable) -> bool:
     """Check the rank of Wo for `VEHICLE` and whether it is observable (section 4.2.3)."""
     report = Report("vehicle observability")
     A, C = np.array(VEHICLE["A"]), np.array(VEHICLE["C"])
-    rank_decision_feedback(rank, observable, int(np.linalg.matrix_rank(_obsv(A, C))), A.shape[0],
+    rank_decision_feedback(rank, observable, int(np.linalg.matrix_rank(obsv(A, C))), A.shape[0],
                            report, word="observable",
                            rank_hint="compute C and CA and check whether one row is a multiple "
                                      "of the other.",
@@ -73,8 +67,7 @@ def check_observer_gain(L) -> bool:
     """Check the observer gain L with eig(A - L C) = the poles of `OBSERVER` (4.27)."""
     report = Report("observer gain")
     A, C = np.array(OBSERVER["A"]), np.array(OBSERVER["C"])
-    # duality: eig(A - L C) = eig(A^T - C^T L^T), a state-feedback problem with K = -L^T
-    L_ok = -place(A.T, C.T, OBSERVER["poles"]).T
+    L_ok = place_observer(A, C, OBSERVER["poles"])
     ok = matrix_feedback(L, L_ok, "L", report, known_mistakes=[
         (-L_ok, "L has the wrong sign: the course's estimation error obeys e' = (A - L C) e (4.27); "
                 "you placed the eigenvalues of A + L C."),
@@ -97,8 +90,8 @@ def check_separation_poles(poles) -> bool:
     report = Report("output feedback")
     A, B, C = (np.array(SEPARATION[k]) for k in ("A", "B", "C"))
     K, L = np.array(SEPARATION["K"]), np.array(SEPARATION["L"])
-    # in the coordinates (x, e = x - x^): [[A + B K, -B K], [0, A - L C]]
-    expected = np.concatenate([np.linalg.eigvals(A + B @ K), np.linalg.eigvals(A - L @ C)])
+    # in the coordinates (x, e = x - x^) the loop is block triangular [[A + B K, -B K], [0, A - L C]]
+    expected = np.concatenate(separation_eigenvalues(StateSpace(A, B, C), K, L))
     n = A.shape[0]
     probe = Report("")
     arr = read_poles(poles, "poles", 2 * n, probe)
