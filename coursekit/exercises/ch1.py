@@ -15,6 +15,8 @@ from __future__ import annotations
 import numpy as np
 
 from .. import models
+from ..realization import euler_discretize, ode_to_ss
+from ..systems import StateSpace
 from ._feedback import Report, call_student_function, close, matrix_feedback
 
 __all__ = [
@@ -150,10 +152,8 @@ def check_ode_realization(A, B, C) -> bool:
     a = np.asarray(ODE["a"], dtype=float)
     b = ODE["b"]
     n = a.size
-    A_ok = np.vstack([np.eye(n)[1:], -a])   # superdiagonal ones, last row -a (1.53)
-    B_ok = np.zeros((n, 1))
-    B_ok[-1, 0] = b
-    C_ok = np.eye(n)[:1]
+    ok = ode_to_ss(a, b)       # (1.52)-(1.53): superdiagonal ones, last row -a, B = b e_n, C = e_1^T
+    A_ok, B_ok, C_ok = ok.A, ok.B, ok.C
     matrix_feedback(A, A_ok, "A", report, known_mistakes=[
         (np.vstack([np.eye(n)[1:], a]), "A: the last row is minus the coefficients: "
                                         "y''' = -a0 y - a1 y' - a2 y'' + b u (1.50)."),
@@ -175,9 +175,9 @@ def check_euler_discretization(Ad, Bd) -> bool:
     from scipy.linalg import expm
     report = Report("Euler discretization")
     A, B, Ts = np.array(EULER["A"]), np.array(EULER["B"]), EULER["Ts"]
-    n = A.shape[0]
     # (1.43): x(t+1) = x(t) + Ts (A x(t) + B u(t))
-    Ad_ok, Bd_ok = np.eye(n) + Ts * A, Ts * B
+    discrete = euler_discretize(StateSpace(A, B), Ts)
+    Ad_ok, Bd_ok = discrete.A, discrete.B
     matrix_feedback(Ad, Ad_ok, "Ad", report, known_mistakes=[
         (Ts * A, "Ad: x(t+1) = x(t) + Ts f(x, u) keeps x(t) itself: Ad = I + Ts A, not Ts A (1.43)."),
         (A, "Ad: multiply A by the sampling period Ts and add the identity (1.43)."),

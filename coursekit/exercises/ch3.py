@@ -12,7 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from .. import models
+from ..linearization import linearize
 from ..placement import place
+from ..stability import is_stable
 from ._feedback import Report, matrix_feedback, read_decision
 
 __all__ = [
@@ -44,7 +47,7 @@ LINEARIZE = {"m": 0.5, "l": 0.8, "g": 9.81, "d_theta": 0.3, "x_eq": (np.pi, 0.0)
 def check_stability(answers) -> bool:
     """Check a list of four True/False: is x' = A x stable, for each A of `STABILITY`?"""
     report = Report("stability")
-    truth = [bool(np.all(np.linalg.eigvals(np.array(A)).real < 0)) for A in STABILITY]
+    truth = [is_stable(A) for A in STABILITY]   # every eigenvalue strictly in the left half-plane
     if isinstance(answers, (str, bytes)) or not hasattr(answers, "__len__"):
         report.add(f"answers must be a list of {len(truth)} True/False, one per matrix: "
                    f"received {answers!r}.")
@@ -115,9 +118,8 @@ def check_pendulum_linearization(A, B) -> bool:
     """Check (A, B) of the pendulum `LINEARIZE` linearized at theta = pi, theta' = 0 (3.67)."""
     report = Report("linearized pendulum")
     m, l, g, d = (LINEARIZE[k] for k in ("m", "l", "g", "d_theta"))
-    # Jacobians of f(x, u) = [x2, -(g/l) sin x1 - (d/m) x2 + u / (m l^2)] at x1 = pi (3.69)
-    A_ok = np.array([[0.0, 1.0], [g / l, -d / m]])
-    B_ok = np.array([[0.0], [1.0 / (m * l**2)]])
+    # (3.67): A = df/dx, B = df/du at x* = [pi, 0], u* = 0
+    A_ok, B_ok = linearize(models.pendulum(m=m, l=l, g=g, d_theta=d), LINEARIZE["x_eq"], [0.0])
     matrix_feedback(A, A_ok, "A", report, known_mistakes=[
         ([[0, 1], [-g / l, -d / m]], "A: that is the linearization at the hanging equilibrium "
                                      "theta = 0; at theta = pi, cos(theta) = -1 (3.69)-(3.70)."),
