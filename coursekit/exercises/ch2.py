@@ -13,6 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..controllability import ccf_transform, ctrb
+from ..flatness import car_like_flatness
 from ._feedback import Report, close, matrix_feedback, rank_decision_feedback, read_poles
 
 __all__ = [
@@ -92,14 +93,11 @@ def check_ccf_transform(T) -> bool:
 
 
 def _car_solution(sign: float) -> tuple[float, float]:
-    L = CAR["L"]
-    (d1, d2), (dd1, dd2) = CAR["dF"], CAR["ddF"]
-    # (2.99): v = +- sqrt(F1'^2 + F2'^2)
-    v = sign * np.hypot(d1, d2)
-    # (2.101): theta' = (F2'' F1' - F1'' F2') / (F1'^2 + F2'^2)
-    dtheta = (dd2 * d1 - dd1 * d2) / (d1**2 + d2**2)
-    # (1.11): theta' = v tan(delta) / L
-    return v, float(np.arctan(L * dtheta / v))
+    """(v, delta) from psi_u of the car-like robot's flat output F = (x1, x2) (2.89)."""
+    flat = car_like_flatness(L=CAR["L"], reverse=sign < 0)
+    # (2.99), (2.101) and theta' = v tan(delta) / L (1.11); the position F itself does not matter
+    v, delta = flat.psi_u([np.zeros(2), np.array(CAR["dF"]), np.array(CAR["ddF"])])
+    return float(v), float(delta)
 
 
 def check_car_flatness(v, delta) -> bool:
