@@ -15,7 +15,6 @@ from __future__ import annotations
 import argparse
 import importlib
 import inspect
-import json
 import statistics
 import subprocess
 import sys
@@ -122,33 +121,36 @@ def bench_explorers(repeat: int) -> list[str]:
     return rows
 
 
-def imports_only(nb: dict) -> dict:
-    """A copy of the notebook holding only its import lines (and %matplotlib)."""
+def imports_only(nb):
+    """A copy of the notebook holding only its top-level import lines (and %matplotlib)."""
+    import copy
+    import nbformat
     lines = []
-    for cell in nb["cells"]:
-        if cell["cell_type"] != "code":
+    for cell in nb.cells:
+        if cell.cell_type != "code":
             continue
-        for line in "".join(cell["source"]).splitlines():
-            stripped = line.strip()
-            if line == stripped and (stripped.startswith(("import ", "from ", "%matplotlib"))):
-                lines.append(stripped)
-    baseline = dict(nb, cells=[{"cell_type": "code", "metadata": {}, "outputs": [],
-                                "execution_count": None, "source": "\n".join(dict.fromkeys(lines))}])
+        for line in cell.source.splitlines():
+            if line.startswith(("import ", "from ", "%matplotlib")):
+                lines.append(line.strip())
+    baseline = copy.deepcopy(nb)
+    baseline.cells = [nbformat.v4.new_code_cell("\n".join(dict.fromkeys(lines)))]
     return baseline
 
 
-def run_notebook(nb: dict) -> None:
-    import nbformat
+def run_notebook(nb) -> None:
+    """Execute a notebook in a fresh kernel, from the notebooks/ folder."""
+    import copy
     from nbclient import NotebookClient
-    client = NotebookClient(nbformat.from_dict(nb), timeout=600, kernel_name="python3",
+    client = NotebookClient(copy.deepcopy(nb), timeout=600, kernel_name="python3",
                             resources={"metadata": {"path": str(ROOT / "notebooks")}})
     client.execute()
 
 
 def bench_notebooks(repeat: int) -> list[str]:
+    import nbformat
     rows = ["| notebook | full run | imports only | ratio (target <= 2) |", "|---|---|---|---|"]
     for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
-        nb = json.loads(path.read_text(encoding="utf-8"))
+        nb = nbformat.read(path, as_version=4)
         med = interleaved({"full": lambda: run_notebook(nb),
                            "imports": lambda: run_notebook(imports_only(nb))}, repeat)
         rows.append(f"| {path.name} | {med['full']:.1f} s | {med['imports']:.1f} s "

@@ -263,27 +263,89 @@ def _recurse(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
     """Run x(k+1) = Ad x(k) + w(k) from x(0) = x0, with w(k) = sum of Bj uj(k).
 
     `terms` is a list of pairs ``(Bj, uj)``, each `uj` with one row per step.
-    Fast and exact for any Ad, diagonalizable or not: with the complex Schur
-    form Ad = Z S Z^H (S upper triangular) the coordinates z = Z^H x obey
-    z_i(k+1) = S_ii z_i(k) + [v_i(k) + sum_{j>i} S_ij z_j(k)], v = Z^H w.
-    The last row depends on nothing else; solving the rows from the last to
-    the first, each is a first-order recursion run by `scipy.signal.lfilter`
-    over the whole time axis at once (no Python loop over samples).
+    Fast and exact for any Ad, diagonalizable or not: in a Schur basis
+    Ad = Z S Z^T (S block upper triangular) the coordinates z = Z^T x obey
+    z_i(k+1) = S_ii z_i(k) + [v_i(k) + sum_{j>i} S_ij z_j(k)], v = Z^T w.
+    The last block depends on nothing else; solving the blocks from the last
+    to the first, each is a recursion of order one (a real eigenvalue) or two
+    (a complex pair) run by `scipy.signal.lfilter` over the whole time axis at
+    once, with no Python loop over samples.
     """
     from scipy.linalg import schur
-    from scipy.signal import lfilter
-    S, Z = schur(Ad, output="complex")
-    n = x0.size
-    z = np.empty((n, terms[0][1].shape[0] + 1), dtype=complex)
+    S, Z = schur(Ad, output="real")
+    blocks = _schur_blocks(S)
+    pairs = {i: _pair_modes(S[i:i + 2, i:i + 2]) for i, size in blocks if size == 2}
+    if any(mode is None for mode in pairs.values()):
+        return _recurse_complex(Ad, x0, terms)
+    z = _projected_input(Z, x0, terms)
+    for i, size in reversed(blocks):
+        _solve_block(S, z, i, size, pairs.get(i))
+    # x = Z z, time-major
+    x = z.T @ Z.T
+    x[0] = x0  # exactly, not after a round trip through the Schur basis
+    return x
+
+
+def _schur_blocks(S: np.ndarray) -> list:
+    """(start, size) of the 1x1 and 2x2 diagonal blocks of a real Schur form."""
+    blocks, i, n = [], 0, S.shape[0]
+    while i < n:
+        size = 2 if i + 1 < n and S[i + 1, i] != 0.0 else 1
+        blocks.append((i, size))
+        i += size
+    return blocks
+
+
+def _pair_modes(M: np.ndarray):
+    """Eigen-decomposition (lambda, p, r) of a 2x2 block with a complex pair, or None.
+
+    With M = P diag(lambda, conj(lambda)) P^-1, p the first column of P and r the
+    first row of P^-1, a real recursion y(k+1) = M y(k) + e(k) is
+    y = 2 Re(p q) with q(k+1) = lambda q(k) + r e(k): one complex first-order
+    filter. None when P is badly conditioned (a nearly repeated eigenvalue).
+    """
+    values, P = np.linalg.eig(M)
+    if np.linalg.cond(P) > 1e4:
+        return None
+    return values[0], P[:, 0], np.linalg.inv(P)[0]
+
+
+def _projected_input(Z: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
+    """z(0) = Z^T x0 and z(k+1) slots holding v(k) = Z^T w(k), as an (n, N) array."""
+    z = np.zeros((x0.size, terms[0][1].shape[0] + 1), dtype=Z.dtype)
     z[:, 0] = Z.conj().T @ x0
-    z[:, 1:] = sum((Z.conj().T @ Bj) @ uj.T for Bj, uj in terms)
-    for i in range(n - 1, -1, -1):
-        if i + 1 < n:
-            z[i, 1:] += (S[i, i + 1:] @ z[i + 1:])[:-1]
+    for Bj, uj in terms:  # Z^H w = sum of (Z^H Bj) uj, one input column at a time
+        G = Z.conj().T @ Bj
+        for col in range(G.shape[1]):
+            z[:, 1:] += G[:, col:col + 1] * uj[:, col]
+    return z
+
+
+def _solve_block(S: np.ndarray, z: np.ndarray, i: int, size: int, modes) -> None:
+    """Replace rows i..i+size-1 of z (input on entry) by the block's solution."""
+    from scipy.signal import lfilter
+    rows = slice(i, i + size)
+    if i + size < S.shape[0]:
+        z[rows, 1:] += (S[rows, i + size:] @ z[i + size:])[:, :-1]
+    if size == 1:
         # y(0) = z_i(0), y(k+1) = S_ii y(k) + input(k)
         z[i] = lfilter([1.0], [1.0, -S[i, i]], z[i])
-    x = (Z @ z).real.T.copy()
-    x[0] = x0  # exactly, not after a round trip through the Schur basis
+    else:
+        lam, p, r = modes
+        q = lfilter([1.0], [1.0, -lam], r @ z[rows])
+        z[rows] = 2.0 * (p[:, None] * q).real
+
+
+def _recurse_complex(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
+    """`_recurse` through the complex Schur form: triangular, so robust when
+    eigenvalues nearly coincide, at about twice the cost."""
+    from scipy.linalg import schur
+    S, Z = schur(Ad, output="complex")
+    z = _projected_input(Z, x0, terms)
+    for i in range(x0.size - 1, -1, -1):
+        _solve_block(S, z, i, 1, None)
+    x = (z.real.T @ Z.real.T) - (z.imag.T @ Z.imag.T)
+    x[0] = x0
     return x
 
 

@@ -164,3 +164,25 @@ def test_batch_rejects_a_vector_field_that_cannot_take_a_batch():
     scalar_only = ck.NonlinearSystem(lambda x, u: [float(x[1]), -float(x[0])], n=2)
     with pytest.raises(ValueError, match=r"f cannot be evaluated on a batch"):
         ck.simulate_batch(scalar_only, np.linspace(0, 1, 3), [[1, 0], [0, 1]])
+
+
+@pytest.mark.parametrize("A", [
+    [[0.0, 1.0], [-4.0, -0.2]],                    # a complex pair: one complex filter
+    [[-1.0, 1.0], [-1e-12, -1.0]],                 # a nearly repeated pair: complex Schur fallback
+    [[-1.0, 1.0, 0, 0], [0, -1.0, 1.0, 0], [0, 0, -1.0, 0], [0, 0, 0, 0.5]],  # Jordan block
+])
+def test_exact_path_matches_the_solution_formula_for_every_block_type(A):
+    A = np.array(A)
+    n = A.shape[0]
+    B = np.ones((n, 1))
+    t = np.linspace(0, 3, 61)
+    u = np.cos(2 * t)
+    x0 = np.arange(1.0, n + 1)
+    res = ck.simulate(ck.StateSpace(A, B), t, u, x0=x0)
+    # reference: the same piecewise-linear input, stepped with the one-step matrices
+    Ad, B0, B1 = ck.lti_step_matrices(A, B, t[1] - t[0])
+    x = x0.copy()
+    for k in range(t.size):
+        np.testing.assert_allclose(res.x[k], x, rtol=1e-10, atol=1e-10)
+        if k + 1 < t.size:
+            x = Ad @ x + B0[:, 0] * u[k] + B1[:, 0] * u[k + 1]
