@@ -47,7 +47,8 @@ def _gain(K, name: str = "K") -> np.ndarray:
 class StateFeedback:
     """u = K (x - x*) + u*: linear state feedback around an equilibrium (3.92), (3.100).
 
-    Call it as ``controller(t, x)`` (the signature `simulate` expects).
+    Call it as ``controller(t, x)`` (the signature `simulate` expects); with
+    x a batch (n, k) of states it returns (m, k), as `simulate_batch` expects.
     For a nonlinear plant, K comes from the linearization at (x*, u*)
     (3.88)-(3.91) and the law only works near x*; for a linear plant
     x' = A x + B u with A x* + B u* = 0 (3.94) it works globally (3.98)-(3.100).
@@ -62,8 +63,12 @@ class StateFeedback:
             u_eq, "u_eq", size=m, why=f"one per input, since K is {m}x{n}")
 
     def __call__(self, t, x) -> np.ndarray:
+        x = np.asarray(x, dtype=float)
+        if x.ndim == 2:
+            # a batch (n, k) of states, one per column, as `simulate_batch` passes it
+            return self.K @ (x - self.x_eq[:, None]) + self.u_eq[:, None]
         # (3.92): u = K (x - x*) + u*
-        return self.K @ (np.asarray(x, dtype=float) - self.x_eq) + self.u_eq
+        return self.K @ (x - self.x_eq) + self.u_eq
 
     def __repr__(self) -> str:
         return f"StateFeedback(K={_fmt(self.K)}, x_eq={_fmt(self.x_eq)}, u_eq={_fmt(self.u_eq)})"
@@ -244,7 +249,8 @@ class PendulumLinearizingController:
     the poles at the roots of s^2 + p1 s + p0. With theta_ref = 0 this is
     exactly (3.154); theta_ref = pi holds the pendulum upright (theta = 0
     hangs down, as in `models.pendulum`). `poles` gives the two desired
-    closed-loop poles (p1 = -(sum), p0 = product).
+    closed-loop poles (p1 = -(sum), p0 = product). Called with a batch x of
+    shape (2, k) it returns (1, k), so it also works in `simulate_batch`.
     """
 
     def __init__(self, poles, *, m: float = 1.0, l: float = 1.0, g: float = 9.81,
@@ -258,7 +264,8 @@ class PendulumLinearizingController:
         self.theta_ref = as_scalar(theta_ref, "theta_ref")
 
     def __call__(self, t, x) -> np.ndarray:
-        x1, x2 = float(x[0]), float(x[1])
+        # x1, x2 are numbers, or rows of a batch (2, k) of states as `simulate_batch` passes it
+        x1, x2 = np.asarray(x[0], dtype=float), np.asarray(x[1], dtype=float)
         # (3.147): v = -p0 x1 - p1 x2, measured from the target angle
         v = -self.p0 * (x1 - self.theta_ref) - self.p1 * x2
         # (3.153): u = m g l sin(x1) + m l^2 v (+ the damping term)

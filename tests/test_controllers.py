@@ -45,6 +45,21 @@ def test_feedback_linearization_makes_the_closed_loop_exactly_linear_3_154():
     np.testing.assert_allclose(res.x - [np.pi, 0], lin.x, atol=1e-6)
 
 
+def test_controllers_accept_a_batch_of_states_column_by_column():
+    # simulate_batch passes X of shape (n, k); each column must give the single-state answer
+    X = np.array([[np.pi - 0.3, np.pi + 0.5, 0.1], [0.0, -1.0, 2.0]])
+    for ctrl in (ck.StateFeedback([[-15.81, -5.0]], [np.pi, 0.0], [0.5]),
+                 ck.PendulumLinearizingController([-2, -3], theta_ref=np.pi, d_theta=0.2)):
+        U = ctrl(0.0, X)
+        assert U.shape == (1, 3)
+        np.testing.assert_allclose(U, np.column_stack([ctrl(0.0, X[:, j]) for j in range(3)]), rtol=1e-14)
+    P = ck.models.pendulum()
+    ctrl = ck.PendulumLinearizingController([-2, -3], theta_ref=np.pi)
+    batch = ck.simulate_batch(P, T, X.T, u=ctrl)
+    for j in range(3):
+        np.testing.assert_allclose(batch[:, j], ck.simulate(P, T, u=ctrl, x0=X[:, j]).x, atol=1e-7)
+
+
 def test_tracking_controller_follows_a_feasible_trajectory_3_104():
     A, B = np.array([[0, 1], [0, 0.0]]), np.array([[0], [1.0]])
     x_d = lambda t: np.array([np.sin(t), np.cos(t)])            # noqa: E731
