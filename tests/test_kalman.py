@@ -215,3 +215,17 @@ def test_noise_bad_inputs():
         ck.white_noise([0, 1, 2], 1.0, seed="x")
     with pytest.raises(ValueError, match=r"R must be positive semidefinite"):
         ck.simulate_with_noise(ck.StateSpace(A, B, C), [0, 1, 2], Q=Q, R=[[-1]])
+
+
+@settings(max_examples=40)
+@given(st.integers(1, 4), st.integers(0, 10_000), st.floats(1e-4, 1.0))
+def test_step_length_shortcut_is_the_exact_rule(n, seed, h_max):
+    # the RK4 step is min(h_max, 0.5 / rate); the cheap bound may only skip the eigenvalues when
+    # they could not shorten the step, so the result must equal the exact rule every time
+    from coursekit.kalman import _radius_bound, _riccati_rate, _step_length
+    rng = np.random.default_rng(seed)
+    A_, L_, C_ = rng.normal(size=(n, n)) * 10 ** rng.uniform(-1, 2), rng.normal(size=(n, 1)), rng.normal(size=(1, n))
+    M = A_ - L_ @ C_
+    assert _radius_bound(M) >= np.abs(np.linalg.eigvals(M)).max()
+    exact = min(h_max, 0.5 / max(_riccati_rate(A_, L_, C_), 1e-300))
+    assert _step_length(A_, L_, C_, h_max) == exact
