@@ -159,7 +159,9 @@ def _pendulum():
     # first equation x1' = x2 gives x2 = F'
     x2 = sp.diff(x1, t)
     # second equation (1.8): m l^2 x2' + d l^2 x2 + m g l sin x1 = u, solved for u
-    u_expr = sp.solve(sp.Eq(m * l**2 * sp.diff(x2, t) + d * l**2 * x2 + m * g * l * sp.sin(x1), u), u)[0]
+    # (linear in u: solve without its simplify pass, whose trigsimp is slow; factor gives the same form)
+    u_expr = sp.factor(sp.solve(sp.Eq(m * l**2 * sp.diff(x2, t) + d * l**2 * x2 + m * g * l * sp.sin(x1), u),
+                                u, simplify=False)[0])
     derivs = _derivative_symbols(2, 1)
     psi_x = sp.Matrix([_to_symbols(e, [F], t, derivs) for e in (x1, x2)])
     psi_u = sp.Matrix([_to_symbols(u_expr, [F], t, derivs)])
@@ -174,12 +176,12 @@ def _planar(car: bool):
     v = sp.Symbol("v", positive=True)
     d1, d2 = sp.diff(F1, t), sp.diff(F2, t)
     # (2.98): squaring and adding the first two equations: v^2 = F1'^2 + F2'^2, forward root
-    roots = sp.solve(sp.Eq(v**2, d1**2 + d2**2), v)
+    roots = sp.solve(sp.Eq(v**2, d1**2 + d2**2), v, simplify=False)
     speed = next(r for r in roots if not r.could_extract_minus_sign())
     # (2.96)-(2.97): dividing them: tan(theta) = F2'/F1'; atan2 picks the quadrant of (cos, sin)
     theta = sp.atan2(d2, d1)
-    # (2.100)-(2.101): theta' by differentiation
-    theta_dot = sp.simplify(sp.diff(theta, t))
+    # (2.100)-(2.101): theta' by differentiation, over one common denominator
+    theta_dot = sp.cancel(sp.diff(theta, t))
     derivs = _derivative_symbols(2, 2)
     funcs = [F1, F2]
     psi_x = sp.Matrix([_to_symbols(e, funcs, t, derivs) for e in (F1, F2, theta)])
@@ -187,7 +189,8 @@ def _planar(car: bool):
         L = sp.Symbol("L", positive=True)
         delta = sp.Symbol("delta")
         # (1.11): theta' = v tan(delta) / L, solved for delta
-        second = sp.solve(sp.Eq(theta_dot, speed * sp.tan(delta) / L), delta)[0]
+        # (simplified once below, with the other map)
+        second = sp.solve(sp.Eq(theta_dot, speed * sp.tan(delta) / L), delta, simplify=False)[0]
     else:
         # (2.94): theta' = u2
         second = theta_dot
