@@ -12,7 +12,7 @@
 
 from __future__ import annotations
 
-from math import factorial
+from math import factorial, isfinite
 from typing import Callable
 
 import numpy as np
@@ -65,6 +65,9 @@ class PolyTrajectory:
         return 2 * self.r - 1
 
     def __call__(self, t, k=0):
+        if isinstance(t, float) and isfinite(t) and type(k) is int and k >= 0:
+            # one finite time, as an ODE solver asks at every step: skip the array checks
+            return self._scalar_derivatives(t, k)[k]
         tt, scalar = _times(t)
         values = self._eval(tt, _derivative_order(k))
         return float(values[0]) if scalar else values
@@ -230,8 +233,14 @@ class OpenLoopPlan:
         return np.linalg.solve(self.transform, z.T).T
 
     def input(self, t, x=None) -> np.ndarray:
-        """``u(t, x)`` for `simulate`: the open-loop input ignores x."""
-        return np.array([self.ud(t)])
+        """``u(t, x)`` for `simulate`: the open-loop input ignores x (t is clipped to [0, T])."""
+        tt = min(max(float(t), 0.0), self.horizon)
+        # the same u_d as ud(t), (2.25) with b = 1, without re-checking t at every solver step
+        y = self.yd._scalar_derivatives(tt, self.n)
+        total = y[self.n]
+        for i in range(self.n):
+            total = total + self.a[i] * y[i]
+        return np.array([total])
 
     def plot(self, samples: int = 301):
         """Figure of the planned states x(t) and the input u_d(t) on [0, T]; returns the figure."""
