@@ -429,14 +429,19 @@ def simulate_with_noise(sys, t, u=None, x0=None, *, Q, R, seed=None) -> Simulati
         Ad, B0, B1 = lti_step_matrices(sys.A, sys.B, dt)
         # white_noise samples have covariance intensity / dt, so intensity Qd dt gives Qd
         w = white_noise(t, _van_loan(sys.A, Q, dt) * dt, rng)
+        # everything but Ad x(k), for all k at once: B0 u(k) + B1 u(k+1) + w(k)
+        forcing = u[:-1] @ B0.T + u[1:] @ B1.T + w[:-1]
         for k in range(N - 1):
-            x[k + 1] = Ad @ x[k] + B0 @ u[k] + B1 @ u[k + 1] + w[k]
+            x[k + 1] = Ad @ x[k] + forcing[k]
     else:
         sys.check(x0, u[0])
         w = white_noise(t, Q, rng)
         for k in range(N - 1):
             x[k + 1] = _rk4_held(sys.f, x[k], u[k], u[k + 1], w[k], dt)
-    y_clean = np.array([sys.h(xk, uk) for xk, uk in zip(x, u)]).reshape(N, -1)
+    if isinstance(sys, StateSpace):
+        y_clean = x @ sys.C.T + u @ sys.D.T                 # y = C x + D u at every sample
+    else:
+        y_clean = np.array([sys.h(xk, uk) for xk, uk in zip(x, u)]).reshape(N, -1)
     R = _covariance(R, "R", y_clean.shape[1], definite=False)
     y = y_clean + white_noise(t, R, rng)
     return SimulationResult(t=t, x=x, y=y, u=u, system=sys)
