@@ -113,7 +113,8 @@ def lab(tmp_path_factory):
     cmd = [sys.executable, "-m", "jupyterlab", "--no-browser", "--ServerApp.open_browser=False",
            "--ServerApp.ip=127.0.0.1", f"--ServerApp.port={port}", "--ServerApp.port_retries=0",
            f"--ServerApp.root_dir={root}", f"--IdentityProvider.token={TOKEN}",
-           f"--LabApp.user_settings_dir={settings}", f"--LabApp.workspaces_dir={base / 'workspaces'}"]
+           f"--LabApp.user_settings_dir={settings}", f"--LabApp.workspaces_dir={base / 'workspaces'}",
+           "--LabApp.expose_app_in_browser=True"]
     if hasattr(os, "geteuid") and os.geteuid() == 0:
         cmd.append("--allow-root")
     env = dict(os.environ, JUPYTER_CONFIG_DIR=str(base / "config"), JUPYTER_RUNTIME_DIR=str(base / "runtime"),
@@ -171,6 +172,10 @@ _ERRORS_JS = """() => Array.from(document.querySelectorAll(
 _KERNEL_IDLE_JS = """() => document.querySelector(
     '.jp-NotebookPanel:not(.lm-mod-hidden) .jp-Notebook-ExecutionIndicator')?.dataset.status === 'idle'"""
 
+# from the notebook model, so cells whose input is collapsed (the exercise solutions) count too
+_EXECUTION_COUNTS_JS = """() => window.jupyterapp.shell.currentWidget.content.widgets
+    .filter(c => c.model.type === 'code').map(c => c.model.executionCount)"""
+
 _EXPLORER_IMAGES_JS = """() => Array.from(document.querySelectorAll(
     '.jp-NotebookPanel:not(.lm-mod-hidden) .widget-vbox img')).map(i => i.src)"""
 
@@ -201,7 +206,7 @@ def _wait_until_done(page, timeout: float) -> list[str]:
     while time.monotonic() < deadline:
         prompts = page.evaluate(_PROMPTS_JS)
         busy = any("*" in p for p in prompts)
-        started = started or busy or (bool(prompts) and all(map(_executed, prompts)))
+        started = started or busy or (bool(prompts) and any(map(_executed, prompts)))
         if started and not busy and page.evaluate(_KERNEL_IDLE_JS):
             return prompts
         page.wait_for_timeout(250)
@@ -236,35 +241,64 @@ def _move_first_slider(page) -> None:
     page.keyboard.press("Tab")
 
 
-def _open_notebook(page, lab: str, name: str) -> None:
-    # a fresh workspace per notebook (?reset), so no tab of an earlier test is restored
-    workspace = re.sub(r"\W", "-", name)
-    page.goto(f"{lab}/lab/workspaces/{workspace}/tree/{name}?reset&token={TOKEN}")
+def _open_notebook(page, name: str) -> None:
+    """Open `name` in the already loaded JupyterLab (no page reload) and wait for its kernel."""
+    page.evaluate("name => window.jupyterapp.commands.execute('docmanager:open', "
+                  "{path: name, factory: 'Notebook'})", name)
+    page.wait_for_function("name => Array.from(window.jupyterapp.shell.widgets('main'))"
+                           ".some(w => w.context?.path === name && w.isVisible)",
+                           arg=name, timeout=60_000)
+    page.evaluate("name => { const w = Array.from(window.jupyterapp.shell.widgets('main'))"
+                  ".find(w => w.context?.path === name); window.jupyterapp.shell.activateById(w.id); }",
+                  name)
     page.wait_for_selector(".jp-NotebookPanel:not(.lm-mod-hidden) .jp-Cell", timeout=60_000)
-    # the kernel is ready when the status bar says "Python 3 (ipykernel) | Idle"
-    page.wait_for_function("() => /\\|\\s*Idle/.test(document.querySelector('#jp-main-statusbar')"
-                           "?.textContent || '')", timeout=90_000)
+    # the kernel is ready when the notebook's session reports an idle kernel
+    page.wait_for_function("name => Array.from(window.jupyterapp.shell.widgets('main'))"
+                           ".some(w => w.context?.path === name"
+                           " && w.sessionContext?.session?.kernel?.status === 'idle')",
+                           arg=name, timeout=90_000)
+
+
+def _close_all(page) -> None:
+    """Save (into the temporary root) and close every tab, so no 'unsaved changes' dialog appears."""
+    page.evaluate("""async () => {
+        for (const widget of Array.from(window.jupyterapp.shell.widgets('main'))) {
+            if (widget.context) { await widget.context.save(); }
+            widget.dispose();
+        }
+    }""")
+    page.wait_for_function("() => !document.querySelector('.jp-NotebookPanel')", timeout=30_000)
+
+
+@pytest.fixture(scope="module")
+def page(lab, browser):
+    """One JupyterLab page for all notebooks: loading the application once saves seconds per test."""
+    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+    page.goto(f"{lab}/lab?reset&token={TOKEN}")
+    page.wait_for_function("() => window.jupyterapp?.commands?.hasCommand('docmanager:open')",
+                           timeout=90_000)
+    yield page
+    page.close()
 
 
 @pytest.mark.parametrize("name", ["demo_explorer.ipynb", *_chapter_notebooks()])
-def test_notebook_runs_in_jupyterlab_and_its_explorer_answers(name, lab, browser, capsys, tmp_path):
-    page = browser.new_page(viewport={"width": 1400, "height": 1000})
+def test_notebook_runs_in_jupyterlab_and_its_explorer_answers(name, lab, page, capsys, tmp_path):
     try:
-        _check_notebook(page, name, lab, capsys)
+        _check_notebook(page, name, capsys)
     except BaseException:
         shot = tmp_path / f"{name}.png"
         page.screenshot(path=str(shot), full_page=True)
         print(f"screenshot of the failing page: {shot}")
         raise
     finally:
-        page.close()
+        _close_all(page)
         _shut_down_kernels(lab)
 
 
-def _check_notebook(page, name: str, lab: str, capsys) -> None:
+def _check_notebook(page, name: str, capsys) -> None:
     """Open, run all, look for errors, move a slider; print the timings."""
     t0 = time.monotonic()
-    _open_notebook(page, lab, name)
+    _open_notebook(page, name)
     t_open = time.monotonic() - t0
     _run_all(page)
     prompts = _wait_until_done(page, RUN_TIMEOUT_S)
@@ -273,8 +307,9 @@ def _check_notebook(page, name: str, lab: str, capsys) -> None:
     assert not errors, f"{name}: a cell shows an error:\n" + "\n----\n".join(errors)
     assert len(prompts) == _count_code_cells(name), (
         f"{name}: {len(prompts)} code cells rendered, the notebook has {_count_code_cells(name)}")
-    not_run = [i for i, p in enumerate(prompts) if not _executed(p)]
-    assert not not_run, f"{name}: code cells {not_run} did not run (prompts {prompts})"
+    counts = page.evaluate(_EXECUTION_COUNTS_JS)
+    not_run = [i for i, count in enumerate(counts) if count is None]
+    assert not not_run, f"{name}: code cells {not_run} did not run (execution counts {counts})"
     images = page.evaluate(_EXPLORER_IMAGES_JS)
     assert images, f"{name}: no explorer figure (a widget with an image) was rendered"
     t1 = time.monotonic()
