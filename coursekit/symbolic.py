@@ -14,6 +14,7 @@ sympy is imported inside the functions, so ``import coursekit`` stays fast.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 __all__ = [
     "SymbolicFlatMaps",
@@ -199,6 +200,14 @@ def _planar(car: bool):
     return name, derivs, psi_x, psi_u
 
 
+@lru_cache(maxsize=None)
+def _derivation(system: str):
+    """The maps of `system`, derived once per session (sympy is slow); callers copy them."""
+    if system == "pendulum":
+        return _pendulum()
+    return _planar(car=system == "car_like")
+
+
 def symbolic_flat_maps(system: str, **params) -> SymbolicFlatMaps:
     """Derive psi_x and psi_u with sympy from the model equations.
 
@@ -210,10 +219,8 @@ def symbolic_flat_maps(system: str, **params) -> SymbolicFlatMaps:
     import sympy as sp
     if system not in _SYSTEMS:
         raise ValueError(f"system must be one of {_SYSTEMS}: received {system!r}.")
-    if system == "pendulum":
-        name, derivs, psi_x, psi_u = _pendulum()
-    else:
-        name, derivs, psi_x, psi_u = _planar(car=system == "car_like")
+    name, derivs, psi_x, psi_u = _derivation(system)
+    derivs = [list(row) for row in derivs]  # fresh containers: the cached ones stay untouched
     flat_symbols = {s for row in derivs for s in row}
     known = {s.name: s for s in (psi_x.free_symbols | psi_u.free_symbols) - flat_symbols}
     for key, value in params.items():
