@@ -189,13 +189,13 @@ def _planar(car: bool):
     if car:
         L = sp.Symbol("L", positive=True)
         delta = sp.Symbol("delta")
-        # (1.11): theta' = v tan(delta) / L, solved for delta
-        # (simplified once below, with the other map)
-        second = sp.solve(sp.Eq(theta_dot, speed * sp.tan(delta) / L), delta, simplify=False)[0]
+        # (1.11): theta' = v tan(delta) / L, solved for delta (one simplify, for the signs)
+        second = sp.simplify(sp.solve(sp.Eq(theta_dot, speed * sp.tan(delta) / L), delta, simplify=False)[0])
     else:
         # (2.94): theta' = u2
         second = theta_dot
-    psi_u = sp.Matrix([_to_symbols(sp.simplify(e), funcs, t, derivs) for e in (speed, second)])
+    # speed (the root) and theta' (over one denominator) are already in their simplest form
+    psi_u = sp.Matrix([_to_symbols(e, funcs, t, derivs) for e in (speed, second)])
     name = "car-like robot" if car else "two-wheeled robot"
     return name, derivs, psi_x, psi_u
 
