@@ -17,7 +17,6 @@ Three paths, chosen from the system and the input:
 
 from __future__ import annotations
 
-import sys as _sys
 from dataclasses import dataclass
 from typing import Callable
 
@@ -324,45 +323,17 @@ def _projected_input(Z: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
 
 def _solve_block(S: np.ndarray, z: np.ndarray, i: int, size: int, modes) -> None:
     """Replace rows i..i+size-1 of z (input on entry) by the block's solution."""
+    from scipy.signal import lfilter
     rows = slice(i, i + size)
     if i + size < S.shape[0]:
         z[rows, 1:] += (S[rows, i + size:] @ z[i + size:])[:, :-1]
     if size == 1:
         # y(0) = z_i(0), y(k+1) = S_ii y(k) + input(k)
-        z[i] = _first_order(S[i, i], z[i])
+        z[i] = lfilter([1.0], [1.0, -S[i, i]], z[i])
     else:
         lam, p, r = modes
-        q = _first_order(lam, r @ z[rows])
+        q = lfilter([1.0], [1.0, -lam], r @ z[rows])
         z[rows] = 2.0 * (p[:, None] * q).real
-
-
-def _first_order(a, v: np.ndarray) -> np.ndarray:
-    """y(0) = v(0), y(k) = a y(k-1) + v(k): what ``lfilter([1], [1, -a], v)`` computes.
-
-    If scipy.signal is already imported, lfilter runs it. Otherwise LAPACK's
-    banded triangular solve (?tbtrs: unit lower bidiagonal, no pivoting) does
-    the same forward substitution, operation for operation, which spares a
-    session that needs nothing else from scipy.signal its import (about half
-    a second, e.g. at the first simulation in a notebook).
-    """
-    if "scipy.signal" in _sys.modules:
-        from scipy.signal import lfilter
-        return lfilter([1.0], [1.0, -a], v)
-    return _first_order_lapack(a, v)
-
-
-def _first_order_lapack(a, v: np.ndarray) -> np.ndarray:
-    """`_first_order` by forward substitution with LAPACK ?tbtrs (no scipy.signal)."""
-    from scipy.linalg import lapack
-    cplx = np.iscomplexobj(v) or np.iscomplexobj(a)
-    dtype = complex if cplx else float
-    # band storage of the matrix with 1 on the diagonal and -a below it: y(k) - a y(k-1) = v(k)
-    band = np.empty((2, v.size), dtype=dtype)
-    band[0] = 1.0
-    band[1] = -a
-    solve = lapack.ztbtrs if cplx else lapack.dtbtrs
-    y, _ = solve(band, np.array(v, dtype=dtype)[:, None], uplo="L", diag="U", overwrite_b=1)
-    return y[:, 0]
 
 
 def _recurse_complex(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
