@@ -68,10 +68,15 @@ def test_separation_principle(n, seed):
     K = ck.place(A_, B_, -np.linspace(1, 2, n))
     L = ck.place_observer(A_, C_, -np.linspace(3, 4, n))
     cl = ck.output_feedback(ck.StateSpace(A_, B_, C_), K, L)
-    expected = np.concatenate(ck.separation_eigenvalues(ck.StateSpace(A_, B_, C_), K, L))
-    # clustered eigenvalues of a non-normal matrix are ill-conditioned: compare det(sI - A_cl)
-    target = np.real(np.poly(expected))
-    np.testing.assert_allclose(np.poly(cl.A), target, rtol=1e-6, atol=1e-7 * np.abs(target).max())
+    # in the coordinates [x; e] with e = x - x̂ (T = T^-1 = [[I, 0], [I, -I]]) the closed loop is
+    # block triangular [[A + B K, -B K], [0, A - L C]]: its eigenvalues are those of the two blocks.
+    # (Comparing eigenvalues of the 2n x 2n matrix directly is ill-conditioned for clustered poles.)
+    I, Z = np.eye(n), np.zeros((n, n))
+    T = np.block([[I, Z], [I, -I]])
+    expected = np.block([[A_ + B_ @ K, -B_ @ K], [Z, A_ - L @ C_]])
+    np.testing.assert_allclose(T @ cl.A[:2 * n, :2 * n] @ T, expected, atol=1e-9 * np.abs(expected).max())
+    halves = ck.separation_eigenvalues(ck.StateSpace(A_, B_, C_), K, L)
+    assert sum(len(h) for h in halves) == 2 * n
     for half, poles in ((A_ + B_ @ K, -np.linspace(1, 2, n)), (A_ - L @ C_, -np.linspace(3, 4, n))):
         np.testing.assert_allclose(np.poly(half), np.poly(poles), rtol=1e-6, atol=1e-7 * np.abs(np.poly(poles)).max())
 
