@@ -311,14 +311,20 @@ def _pair_modes(M: np.ndarray):
 
 
 def _projected_input(Z: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
-    """z(0) = Z^T x0 and z(k+1) slots holding v(k) = Z^T w(k), as an (n, N) array."""
-    z = np.zeros((x0.size, terms[0][1].shape[0] + 1), dtype=Z.dtype)
-    z[:, 0] = Z.conj().T @ x0
-    for Bj, uj in terms:  # Z^H w = sum of (Z^H Bj) uj, one input column at a time
-        G = Z.conj().T @ Bj
-        for col in range(G.shape[1]):
-            z[:, 1:] += G[:, col:col + 1] * uj[:, col]
-    return z
+    """z(0) = Z^H x0 and z(k+1) slots holding v(k) = Z^H w(k), as an (n, N) array.
+
+    Built with one matrix product: the columns of ``[Z^H Bj..., Z^H x0]`` times
+    a time-major matrix holding the inputs (shifted by one step) and a 1 at k = 0.
+    """
+    N = terms[0][1].shape[0] + 1
+    G = [Z.conj().T @ Bj for Bj, _ in terms] + [(Z.conj().T @ x0)[:, None]]
+    U = np.zeros((N, sum(g.shape[1] for g in G)))
+    col = 0
+    for (_, uj), g in zip(terms, G):
+        U[1:, col:col + g.shape[1]] = uj
+        col += g.shape[1]
+    U[0, -1] = 1.0
+    return np.hstack(G) @ U.T
 
 
 def _solve_block(S: np.ndarray, z: np.ndarray, i: int, size: int, modes) -> None:
