@@ -18,6 +18,7 @@ __all__ = [
     "as_matrix",
     "as_square",
     "as_vector",
+    "as_series",
     "as_scalar",
     "as_time_grid",
     "is_uniform",
@@ -120,6 +121,18 @@ def as_vector(value, name: str, *, size: int | None = None, why: str = "") -> np
             f"{name} has the wrong length: received {arr.size} entries, expected {size}{reason}."
         )
     return arr
+
+
+def as_series(value, name: str, *, samples: int, channels: int | None = None,
+              samples_why: str = "one row per time in t", channels_why: str = "") -> np.ndarray:
+    """Return a time series as a time-major (samples, channels) float matrix.
+
+    A 1-D array is one channel sampled in time, so it becomes a column.
+    """
+    if np.ndim(value) == 1:
+        value = np.reshape(np.asarray(value, dtype=float), (-1, 1))
+    return as_matrix(value, name, rows=samples, cols=channels, rows_why=samples_why,
+                     cols_why=channels_why)
 
 
 def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False) -> float:

@@ -39,7 +39,8 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_square, as_time_grid, as_vector, is_uniform
+from ._validation import as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
+from .linearization import _jacobian
 from .observability import _obs_pair
 from .simulation import SimulationResult, lti_step_matrices
 from .systems import NonlinearSystem, StateSpace
@@ -141,31 +142,13 @@ class KalmanResult:
                 f"x {self.x.shape}, P (N, {n}, {n}), L (N, {n}, {p})")
 
 
-_CBRT_EPS = float(np.cbrt(np.finfo(float).eps))
-
-
-def _jacobian(fun: Callable, x: np.ndarray, u: np.ndarray) -> np.ndarray:
-    """Central-difference Jacobian d fun / d x at (x, u), one column per state."""
-    step = _CBRT_EPS * np.maximum(1.0, np.abs(x))
-    shifts = np.diag(step)                      # row i: the step along state i only
-    cols = [np.ravel(fun(x + dx, u) - fun(x - dx, u)) for dx in shifts]
-    return np.array(cols).T / (2 * step)
-
-
 def _records(t, u, y, m: int):
     """Validate the recorded grid, input (N, m) and measurement (N, p)."""
     t = as_time_grid(t, "t")
     N = t.size
-    if u is None:
-        u = np.zeros((N, m))
-    else:
-        u = np.asarray(u, dtype=float)
-        u = as_matrix(u.reshape(-1, 1) if u.ndim == 1 else u, "u", rows=N, cols=m,
-                      rows_why="one row per time in t", cols_why="one column per input")
-    y = np.asarray(y, dtype=float)
-    y = as_matrix(y.reshape(-1, 1) if y.ndim == 1 else y, "y", rows=N,
-                  rows_why="one row per time in t")
-    return t, u, y
+    u = np.zeros((N, m)) if u is None else as_series(u, "u", samples=N, channels=m,
+                                                     channels_why="one column per input")
+    return t, u, as_series(y, "y", samples=N)
 
 
 def _riccati_rate(A: np.ndarray, L: np.ndarray, C: np.ndarray) -> float:
@@ -327,7 +310,7 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
     (4.87)-(4.88) where A(t) = ∂f/∂x (4.92) and C(t) = ∂h/∂x (4.93) are
     evaluated at the estimate x̂(t). `dfdx(x, u)` -> (n, n) and
     `dhdx(x, u)` -> (p, n) may be supplied; by default they are computed by
-    central differences (a small private helper, step ~ eps^(1/3)).
+    central differences (step ~ eps^(1/3); the helper `linearize` uses, without its refinement).
 
     `u` (N, m) or None and `y` (N, p) are the recorded data on the grid `t`;
     Q, R are intensities, P0 > 0 the initial P, x0 the initial estimate.
@@ -348,9 +331,9 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
             raise ValueError(f"{name} must be a function (x, u) -> Jacobian, or None for "
                              f"numerical differences: received {type(fun).__name__}.")
     jf = (lambda x, v: np.asarray(dfdx(x, v), float).reshape(sys.n, sys.n)) if dfdx else \
-        (lambda x, v: _jacobian(sys.f, x, v))
+        (lambda x, v: _jacobian(lambda z: sys.f(z, v), x, refine=False))
     jh = (lambda x, v: np.asarray(dhdx(x, v), float).reshape(p_h, sys.n)) if dhdx else \
-        (lambda x, v: _jacobian(sys.h, x, v))
+        (lambda x, v: _jacobian(lambda z: sys.h(z, v), x, refine=False))
     return _run_filter(sys.f, sys.h, jf, jh, t, u, y, Q, R, P0, x0, _substeps(substeps))
 
 

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_matrix
+from ._validation import as_matrix, as_series
 from .systems import StateSpace
 
 __all__ = [
@@ -125,10 +125,8 @@ def observer_tracking_input(K, x_d, u_d) -> np.ndarray:
     K = as_matrix(K, "K")
     m, n = K.shape
     x_d = as_matrix(x_d, "x_d", cols=n, cols_why=f"one column per state, since K is {m}x{n}")
-    u_d = np.asarray(u_d, dtype=float)
-    u_d = as_matrix(u_d.reshape(-1, 1) if u_d.ndim == 1 and m == 1 else u_d, "u_d",
-                    rows=x_d.shape[0], cols=m, rows_why="one row per time, as x_d",
-                    cols_why=f"one column per input, since K is {m}x{n}")
+    u_d = as_series(u_d, "u_d", samples=x_d.shape[0], channels=m, samples_why="one row per time, as x_d",
+                    channels_why=f"one column per input, since K is {m}x{n}")
     # (4.77): v = u_d - K x_d
     return u_d - x_d @ K.T
 

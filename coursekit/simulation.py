@@ -22,7 +22,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_time_grid, as_vector, check_function_output, is_uniform
+from ._validation import as_matrix, as_series, as_time_grid, as_vector, check_function_output, is_uniform
 from .systems import NonlinearSystem, StateSpace
 
 __all__ = ["simulate", "simulate_batch", "SimulationResult", "lti_step_matrices"]
@@ -182,21 +182,13 @@ def _input(sys, t: np.ndarray, u, x0: np.ndarray):
         return None, u_fun
     if m == 0:
         raise ValueError("u was given, but the system has no input (m = 0); leave u=None.")
-    u_arr = _input_array(u, t.size, m)
+    u_arr = as_series(u, "u", samples=t.size, channels=m, channels_why="one column per input")
     if isinstance(sys, StateSpace) or sys.is_discrete:
         return u_arr, None
 
     def interpolated(tk, xk):
         return np.array([np.interp(tk, t, u_arr[:, j]) for j in range(m)])
     return u_arr, interpolated
-
-
-def _input_array(u, N: int, m: int) -> np.ndarray:
-    arr = np.asarray(u)
-    if arr.ndim == 1 and m == 1:
-        u = arr.reshape(-1, 1)
-    return as_matrix(u, "u", rows=N, cols=m, rows_why="one row per time in t",
-                     cols_why="one column per input")
 
 
 def _check_discrete_grid(t: np.ndarray, dt: float) -> None:

@@ -46,3 +46,12 @@ def test_nonlinear_system_checks_its_arguments():
     sys = ck.NonlinearSystem(lambda x, u: -x, n=2, h=lambda x, u: x[0], params={"a": 1.0})
     assert sys.output_size(np.zeros(2), np.zeros(0)) == 1
     assert "a=1" in repr(sys)
+
+
+def test_as_series_makes_a_one_dimensional_signal_a_column():
+    from coursekit._validation import as_series
+    assert as_series([1.0, 2.0, 3.0], "u", samples=3).shape == (3, 1)
+    with pytest.raises(ValueError, match=r"u has the wrong number of rows: received shape \(2, 1\), expected 3"):
+        as_series([1.0, 2.0], "u", samples=3)
+    with pytest.raises(ValueError, match=r"u has the wrong number of columns: received shape \(3, 1\), expected 2"):
+        as_series([1.0, 2.0, 3.0], "u", samples=3, channels=2)
