@@ -88,7 +88,10 @@ def test_single_output_poles_and_python_control(n, seed):
     poles = -np.linspace(1, 2.5, n)
     L = ck.place_observer(A, C, poles)
     assert L.shape == (n, 1)
-    np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A - L @ C)), sorted_eig(poles), atol=1e-5)
+    # six poles 0.3 apart of a non-normal A - L C: the eigenvalues themselves are ill-conditioned,
+    # so check the characteristic polynomial, as test_placement does for A + B K
+    p = ck.poly_from_roots(poles)
+    np.testing.assert_allclose(ck.charpoly(A - L @ C), p, rtol=1e-6, atol=1e-6 * np.abs(p).max())
     # (4.84): L = place(A^T, C^T, P)^T in MATLAB's sign; acker is the single-output oracle
     L_ref = np.atleast_2d(control.acker(A.T, C.T, poles)).T
     np.testing.assert_allclose(L, L_ref, rtol=1e-6, atol=1e-8 * np.abs(L_ref).max())
