@@ -272,8 +272,8 @@ def _recurse(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
     z = _projected_input(Z, x0, terms)
     for i, size in reversed(blocks):
         _solve_block(S, z, i, size, pairs.get(i))
-    # x = Z z, time-major
-    x = z.T @ Z.T
+    _to_original_basis(Z, z)
+    x = z.T  # time-major view of the (n, N) array: columns contiguous, no copy
     x[0] = x0  # exactly, not after a round trip through the Schur basis
     return x
 
@@ -294,44 +294,67 @@ def _pair_modes(M: np.ndarray):
     With M = P diag(lambda, conj(lambda)) P^-1, p the first column of P and r the
     first row of P^-1, a real recursion y(k+1) = M y(k) + e(k) is
     y = 2 Re(p q) with q(k+1) = lambda q(k) + r e(k): one complex first-order
-    filter. None when P is badly conditioned (a nearly repeated eigenvalue).
+    filter. In closed form, for M = [[a, b], [c, d]] with a complex pair
+    lambda = (a + d)/2 + i w: p = [b, lambda - a], r = [conj(lambda) - a, -b] / (-2 i w b).
+    None when P is badly conditioned (cond > 1e4: a nearly repeated eigenvalue).
     """
-    values, P = np.linalg.eig(M)
-    if np.linalg.cond(P) > 1e4:
+    (a, b), (c, d) = M
+    half = 0.5 * (a - d)
+    w = np.sqrt(-(half * half + b * c))
+    lam = complex(0.5 * (a + d), w)
+    p = np.array([b, lam - a])
+    # P = [p, conj(p)]: its squared singular values are |p|^2 +- |p^T p|
+    norm2, overlap = float(np.vdot(p, p).real), abs(p @ p)
+    if norm2 - overlap <= 1e-8 * (norm2 + overlap):
         return None
-    return values[0], P[:, 0], np.linalg.inv(P)[0]
+    r = np.array([lam.conjugate() - a, -b]) / (-2j * w * b)
+    return lam, p, r
 
 
 def _projected_input(Z: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
     """z(0) = Z^H x0 and z(k+1) slots holding v(k) = Z^H w(k), as an (n, N) array.
 
-    Built with one matrix product: the columns of ``[Z^H Bj..., Z^H x0]`` times
-    a time-major matrix holding the inputs (shifted by one step) and a 1 at k = 0.
+    One matrix product writes all the inputs' contributions into place:
+    ``[Z^H B1, Z^H B2, ...]`` times the inputs side by side, transposed.
     """
+    ZH = Z.conj().T
     N = terms[0][1].shape[0] + 1
-    G = [Z.conj().T @ Bj for Bj, _ in terms] + [(Z.conj().T @ x0)[:, None]]
-    U = np.zeros((N, sum(g.shape[1] for g in G)))
-    col = 0
-    for (_, uj), g in zip(terms, G):
-        U[1:, col:col + g.shape[1]] = uj
-        col += g.shape[1]
-    U[0, -1] = 1.0
-    return np.hstack(G) @ U.T
+    z = np.empty((x0.size, N), dtype=np.result_type(Z, x0))
+    z[:, 0] = ZH @ x0
+    G = ZH @ np.hstack([Bj for Bj, _ in terms])
+    W = np.hstack([uj for _, uj in terms])
+    np.matmul(G, W.T, out=z[:, 1:])
+    return z
+
+
+def _to_original_basis(Z: np.ndarray, z: np.ndarray) -> None:
+    """Overwrite z (n, N) with x = Z z, a slab of time samples at a time.
+
+    Each sample transforms on its own, so working in place through slabs of
+    about 128 kB needs no second n-by-N array (whose fresh pages would cost
+    as much as the product itself).
+    """
+    width = max(1, 16384 // z.shape[0])
+    for start in range(0, z.shape[1], width):
+        slab = z[:, start:start + width]
+        slab[...] = Z @ slab
 
 
 def _solve_block(S: np.ndarray, z: np.ndarray, i: int, size: int, modes) -> None:
     """Replace rows i..i+size-1 of z (input on entry) by the block's solution."""
     from scipy.signal import lfilter
-    rows = slice(i, i + size)
-    if i + size < S.shape[0]:
-        z[rows, 1:] += (S[rows, i + size:] @ z[i + size:])[:, :-1]
+    k = i + size
+    if k < S.shape[0]:
+        z[i:k, 1:] += S[i:k, k:] @ z[k:, :-1]
     if size == 1:
         # y(0) = z_i(0), y(k+1) = S_ii y(k) + input(k)
         z[i] = lfilter([1.0], [1.0, -S[i, i]], z[i])
-    else:
-        lam, p, r = modes
-        q = lfilter([1.0], [1.0, -lam], r @ z[rows])
-        z[rows] = 2.0 * (p[:, None] * q).real
+        return
+    lam, p, r = modes
+    q = lfilter([1.0], [1.0, -lam], r[0] * z[i] + r[1] * z[i + 1])
+    for row, pj in zip((i, i + 1), 2.0 * p):  # z_row = 2 Re(p_j q), without complex temporaries
+        np.multiply(pj.real, q.real, out=z[row])
+        z[row] -= pj.imag * q.imag
 
 
 def _recurse_complex(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
