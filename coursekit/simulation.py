@@ -7,8 +7,8 @@ Three paths, chosen from the system and the input:
   the solution formula (2.4) is evaluated over each step with one matrix
   exponential of an augmented matrix, so the result has no integration error
   and works for any `A`, diagonalizable or not. On a uniform grid the
-  resulting recursion runs through a Schur form with `lfilter` (see
-  `_recurse`), with no Python loop over samples;
+  resulting recursion runs through a Schur form, one first-order recursion
+  per eigenvalue (see `_recurse`), with no Python loop over samples;
 * discrete-time systems (1.18), (1.27): the difference equation is iterated;
 * everything else (nonlinear systems, inputs given as a function `u(t, x)`):
   `scipy.integrate.solve_ivp` with the DOP853 method and tight tolerances
@@ -260,8 +260,8 @@ def _recurse(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
     z_i(k+1) = S_ii z_i(k) + [v_i(k) + sum_{j>i} S_ij z_j(k)], v = Z^T w.
     The last block depends on nothing else; solving the blocks from the last
     to the first, each is a recursion of order one (a real eigenvalue) or two
-    (a complex pair) run by `scipy.signal.lfilter` over the whole time axis at
-    once, with no Python loop over samples.
+    (a complex pair) solved over the whole time axis at once by
+    `_first_order`, with no Python loop over samples.
     """
     from scipy.linalg import schur
     S, Z = schur(Ad, output="real")
@@ -342,19 +342,38 @@ def _to_original_basis(Z: np.ndarray, z: np.ndarray) -> None:
 
 def _solve_block(S: np.ndarray, z: np.ndarray, i: int, size: int, modes) -> None:
     """Replace rows i..i+size-1 of z (input on entry) by the block's solution."""
-    from scipy.signal import lfilter
     k = i + size
     if k < S.shape[0]:
         z[i:k, 1:] += S[i:k, k:] @ z[k:, :-1]
     if size == 1:
         # y(0) = z_i(0), y(k+1) = S_ii y(k) + input(k)
-        z[i] = lfilter([1.0], [1.0, -S[i, i]], z[i])
+        z[i] = _first_order(S[i, i], z[i])
         return
     lam, p, r = modes
-    q = lfilter([1.0], [1.0, -lam], r[0] * z[i] + r[1] * z[i + 1])
+    q = _first_order(lam, r[0] * z[i] + r[1] * z[i + 1])
     for row, pj in zip((i, i + 1), 2.0 * p):  # z_row = 2 Re(p_j q), without complex temporaries
         np.multiply(pj.real, q.real, out=z[row])
         z[row] -= pj.imag * q.imag
+
+
+def _first_order(a, v: np.ndarray) -> np.ndarray:
+    """y(0) = v(0), y(k) = a y(k-1) + v(k) for all k, as one forward substitution.
+
+    The recursion is the unit lower-bidiagonal system y(k) - a y(k-1) = v(k);
+    LAPACK's banded triangular solve (?tbtrs, no pivoting) runs it in compiled
+    code -- the same operations as ``scipy.signal.lfilter([1], [1, -a], v)``,
+    without importing scipy.signal (most of a second) for it. `v` may be
+    overwritten.
+    """
+    from scipy.linalg import lapack
+    cplx = np.iscomplexobj(v) or isinstance(a, complex) or np.iscomplexobj(a)
+    dtype = complex if cplx else float
+    band = np.empty((2, v.size), dtype=dtype)  # band storage: diagonal row, then the row below
+    band[0] = 1.0
+    band[1] = -a
+    solve = lapack.ztbtrs if cplx else lapack.dtbtrs
+    y, _ = solve(band, np.asarray(v, dtype=dtype)[:, None], uplo="L", diag="U", overwrite_b=1)
+    return y[:, 0]
 
 
 def _recurse_complex(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:

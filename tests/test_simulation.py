@@ -186,3 +186,23 @@ def test_exact_path_matches_the_solution_formula_for_every_block_type(A):
         np.testing.assert_allclose(res.x[k], x, rtol=1e-10, atol=1e-10)
         if k + 1 < t.size:
             x = Ad @ x + B0[:, 0] * u[k] + B1[:, 0] * u[k + 1]
+
+
+@given(st.floats(-1.5, 1.5), st.floats(-1.5, 1.5), st.booleans(), st.integers(0, 10_000))
+def test_first_order_recursion_is_the_filter_it_replaces(re, im, complex_pole, seed):
+    from scipy.signal import lfilter
+    from coursekit.simulation import _first_order
+    a = complex(re, im) if complex_pole else re
+    v = np.random.default_rng(seed).normal(size=50)
+    expected = lfilter([1.0], [1.0, -a], v)
+    np.testing.assert_allclose(_first_order(a, v.copy()), expected, rtol=1e-12, atol=1e-12)
+
+
+def test_exact_simulation_does_not_need_scipy_signal():
+    import subprocess
+    import sys
+    code = ("import sys, numpy as np, coursekit as ck; "
+            "ck.simulate(ck.StateSpace([[0, 1], [-4, -0.2]], [[0], [1]]), np.linspace(0, 1, 11), np.ones(11)); "
+            "print('scipy.signal' in sys.modules)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"
