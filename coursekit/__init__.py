@@ -24,8 +24,8 @@ _MODULES = (
     "placement", "stability", "equilibria", "linearization", "controllers",
     # chapter 4: observability and observers
     "observability", "observers", "kalman",
-    # course tools: figure style
-    "style",
+    # course tools: figure style and layout
+    "style", "layout",
     # course tools: environment check (exercises stay the subpackage coursekit.exercises)
     "environment_check",
 )

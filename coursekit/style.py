@@ -7,7 +7,7 @@ a plot or an explorer makes it readable from the back of a lecture hall.
 
 from __future__ import annotations
 
-__all__ = ["lecture_mode", "is_lecture_mode", "new_figure", "fit_margins", "LECTURE_STYLE"]
+__all__ = ["lecture_mode", "is_lecture_mode", "new_figure", "LECTURE_STYLE"]
 
 #: matplotlib settings applied by ``lecture_mode(True)``.
 LECTURE_STYLE = {
@@ -62,21 +62,7 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplot_kw):
     it as the last expression of a notebook cell.
     """
     from matplotlib.figure import Figure
-    fig = Figure(figsize=figsize, layout="constrained")
+    from .layout import fit_margins
+    fig = fit_margins(Figure(figsize=figsize))
     axes = fig.subplots(nrows, ncols, squeeze=True, **subplot_kw)
     return fig, axes
-
-
-def fit_margins(fig, *, left: float, right: float, bottom: float, top: float,
-                wspace: float | None = None, hspace: float | None = None) -> None:
-    """Give a pyplot figure fixed margins (fractions of the figure), drawn in one pass.
-
-    Fixed margins spare matplotlib the layout pass of ``tight_layout`` or
-    constrained layout, so a notebook full of figures renders faster. In
-    lecture mode the fonts are larger than the margins were chosen for, so
-    constrained layout fits the figure instead.
-    """
-    if is_lecture_mode():
-        fig.set_layout_engine("constrained")
-    else:
-        fig.subplots_adjust(left=left, right=right, bottom=bottom, top=top, wspace=wspace, hspace=hspace)

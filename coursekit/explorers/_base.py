@@ -97,11 +97,12 @@ class Explorer:
     def __init__(self, *, title: str, controls: dict[str, Any], compute: Callable[..., Any],
                  draw: Callable[[Any], Any], update: Callable[[Any, Any], None], figsize=None):
         from matplotlib.figure import Figure
+        from ..layout import fit_margins
         self.title = title
         self.controls = dict(controls)
         self._compute = compute
         self._update = update
-        self.fig = Figure(figsize=figsize, layout="constrained")
+        self.fig = fit_margins(Figure(figsize=figsize))
         self.handles = draw(self.fig)
         self.result = None
         self._png = b""

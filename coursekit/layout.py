@@ -1,0 +1,176 @@
+"""Figure layout by estimate: margins from font sizes and tick labels, in one pass.
+
+matplotlib's constrained and tight layouts find the margins by measuring
+every tick label, axis label and title, which costs about as much as drawing
+the figure again; with a dozen figures per notebook and a redraw per slider
+move, measuring dominates. The space an axes grid needs follows closely from
+the font sizes, the number of text lines and the characters of the tick
+labels, so `fit_margins` estimates it without rendering any text and sets
+it with ``subplots_adjust`` each time the figure is drawn. Larger fonts
+(lecture mode) give larger margins by the same rule.
+"""
+
+from __future__ import annotations
+
+import math
+
+__all__ = ["fit_margins"]
+
+#: advance widths in em of the default font (DejaVu Sans) for tick-label characters
+_CHAR_EM = {**dict.fromkeys("0123456789", 0.636), ".": 0.318, ",": 0.318, " ": 0.318,
+            "\N{MINUS SIGN}": 0.838, "-": 0.361, "+": 0.838, "e": 0.615, "E": 0.632,
+            "\N{MULTIPLICATION SIGN}": 0.838, "%": 0.950, "/": 0.337, ":": 0.337,
+            "(": 0.390, ")": 0.390, "i": 0.278, "l": 0.278}
+_OTHER_EM = 0.65
+_LINE = 1.25         # height of a text line, in font sizes
+_EDGE = 4.0          # points kept free at the figure's edge
+_SUPERSCRIPT = 0.7   # size of mathtext superscripts (log-axis labels 10^k)
+
+_engine_class = None
+
+
+def fit_margins(fig):
+    """Lay the figure's grid of axes out by estimated margins (fast, one draw).
+
+    Attaches a layout engine that, each time the figure is drawn, sizes the
+    margins and the gaps between axes from the tick labels, axis labels,
+    titles and suptitle -- without measuring text -- and applies them with
+    ``subplots_adjust``. Call it once on any figure whose axes come from
+    ``plt.subplots`` or a GridSpec; every figure coursekit draws uses it.
+    Returns the figure.
+    """
+    global _engine_class
+    if _engine_class is None:
+        _engine_class = _make_engine_class()
+    fig.set_layout_engine(_engine_class())
+    return fig
+
+
+def _make_engine_class():
+    """The LayoutEngine subclass, defined on first use (matplotlib loads lazily)."""
+    from matplotlib.layout_engine import LayoutEngine
+
+    class EstimatedMargins(LayoutEngine):
+        """Margins and gaps from `_axes_needs`, set with subplots_adjust at each draw."""
+        _adjust_compatible = True
+        _colorbar_gridspec = False
+
+        def execute(self, fig):
+            _apply(fig)
+
+    return EstimatedMargins
+
+
+def _apply(fig) -> None:
+    axes = [ax for ax in fig.axes if ax.get_visible() and ax.get_subplotspec() is not None]
+    if not axes:
+        return
+    nrows, ncols = axes[0].get_subplotspec().get_gridspec().get_geometry()
+    width, height = fig.get_size_inches() * 72.0
+    spans = [(ax.get_subplotspec().rowspan, ax.get_subplotspec().colspan, _axes_needs(ax)) for ax in axes]
+
+    def outer(side, at_edge):
+        return _EDGE + max([need[side] for rows, cols, need in spans if at_edge(rows, cols)], default=0.0)
+
+    left = outer(0, lambda r, c: c.start == 0)
+    right = outer(1, lambda r, c: c.stop == ncols)
+    bottom = outer(2, lambda r, c: r.stop == nrows)
+    top = outer(3, lambda r, c: r.start == 0) + _suptitle_height(fig)
+    gap_w = max((_gap(spans, k, across=1) for k in range(1, ncols)), default=0.0)
+    gap_h = max((_gap(spans, k, across=0) for k in range(1, nrows)), default=0.0)
+    axes_w = (width - left - right - (ncols - 1) * gap_w) / ncols
+    axes_h = (height - top - bottom - (nrows - 1) * gap_h) / nrows
+    if axes_w <= 0 or axes_h <= 0:
+        return  # the figure is too small for its labels; leave matplotlib's defaults
+    fig.subplots_adjust(left=left / width, right=1 - right / width, bottom=bottom / height,
+                        top=1 - top / height, wspace=gap_w / axes_w, hspace=gap_h / axes_h)
+
+
+def _gap(spans, k: int, across: int) -> float:
+    """Space between grid column (across=1) or row (across=0) k-1 and k, in points."""
+    if across == 1:
+        before = [need[1] for rows, cols, need in spans if cols.stop == k]
+        after = [need[0] for rows, cols, need in spans if cols.start == k]
+    else:
+        before = [need[2] for rows, cols, need in spans if rows.stop == k]
+        after = [need[3] for rows, cols, need in spans if rows.start == k]
+    return max(before, default=0.0) + max(after, default=0.0) + _EDGE
+
+
+def _axes_needs(ax) -> list:
+    """[left, right, bottom, top]: points of text and ticks outside the axes box."""
+    need = [0.0, 0.0, 0.0, 0.0]
+    if ax.axison:
+        _add_axis(ax.yaxis, need, sides=(0, 1), overhang=(2, 3))
+        _add_axis(ax.xaxis, need, sides=(2, 3), overhang=(0, 1))
+    titles = [ax.get_title(loc) for loc in ("left", "center", "right")]
+    lines = max(_lines(text) for text in titles)
+    if lines:
+        from matplotlib import rcParams
+        need[3] += lines * _LINE * ax.title.get_size() + rcParams["axes.titlepad"]
+    return need
+
+
+def _add_axis(axis, need: list, sides, overhang) -> None:
+    """Add one axis' tick labels, ticks and label to `need` (in place)."""
+    labels = _tick_labels(axis)
+    tick = axis.get_major_ticks(1)[0] if labels else None
+    vertical = axis.axis_name == "y"
+    for side, label in zip(sides, (tick.label1, tick.label2) if tick else ()):
+        if not label.get_visible():
+            continue
+        size = label.get_size()
+        across = max(_width(s, size) for s in labels) if vertical else max(_height(s, size) for s in labels)
+        need[side] += tick.get_tick_padding() + tick.get_pad() + across
+        # the first and last labels stick out past the axes' ends by half their length
+        half = (0.5 * _LINE * size if vertical else 0.5 * _width(labels[-1], size))
+        need[overhang[1]] = max(need[overhang[1]], half)
+        if vertical and axis.major.formatter.get_offset():
+            need[overhang[1]] = max(need[overhang[1]], _LINE * size)  # the 1e-5 above the axis
+    text = axis.label.get_text()
+    if text:
+        side = sides[0] if axis.get_label_position() in ("left", "bottom") else sides[1]
+        need[side] += axis.labelpad + _lines(text) * _LINE * axis.label.get_size()
+
+
+def _tick_labels(axis) -> list:
+    """The major tick labels inside the view, as strings (empty if there are none)."""
+    lo, hi = sorted(axis.get_view_interval())
+    locs = [loc for loc in axis.get_majorticklocs() if lo <= loc <= hi]
+    return [s for s in axis.major.formatter.format_ticks(locs) if s] if locs else []
+
+
+def _suptitle_height(fig) -> float:
+    """Points the suptitle takes at the top; one wider than the figure is wrapped."""
+    text = fig.get_suptitle()
+    if not text:
+        return 0.0
+    artist = next(t for t in fig.texts if t.get_text() == text)
+    size = artist.get_size()
+    width, height = fig.get_size_inches() * 72.0
+    lines = sum(math.ceil(_width(line, size) / (width - 2 * _EDGE)) for line in text.split("\n"))
+    artist.set_wrap(lines > _lines(text))
+    # placed with its top at 98 % of the figure height
+    return 0.02 * height + lines * _LINE * size
+
+
+def _lines(text: str) -> int:
+    return text.count("\n") + 1 if text else 0
+
+
+def _plain(s: str) -> tuple[str, str]:
+    """Split a tick label into its normal and its superscript characters (mathtext)."""
+    s = s.replace("$", "").replace("\\mathdefault", "").replace("\\times", "\N{MULTIPLICATION SIGN}")
+    base, _, sup = s.partition("^")
+    strip = str.maketrans("", "", "{}\\")
+    return base.translate(strip), sup.translate(strip)
+
+
+def _width(s: str, size: float) -> float:
+    base, sup = _plain(s)
+    em = sum(_CHAR_EM.get(c, _OTHER_EM) for c in base) + _SUPERSCRIPT * sum(_CHAR_EM.get(c, _OTHER_EM) for c in sup)
+    return em * size
+
+
+def _height(s: str, size: float) -> float:
+    return (_LINE + (0.3 if "^" in s else 0.0)) * size * _lines(s)

@@ -1,0 +1,121 @@
+"""fit_margins: every label inside the figure, no two axes' labels overlapping,
+and not much more margin than matplotlib's measuring constrained layout."""
+
+import matplotlib
+
+matplotlib.use("Agg")
+
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+
+import coursekit as ck  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
+
+
+def _draw(fig):
+    """Draw with Agg (figures from coursekit are built outside pyplot); return the renderer."""
+    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
+    canvas.draw()
+    return canvas.get_renderer()
+
+
+def _response(title="Mass-spring-damper (1.3): step in the force"):
+    sys = ck.models.mass_spring_damper(m=1.0, d=0.5, k=2.0)
+    t = np.linspace(0, 40, 401)
+    return ck.simulate(sys, t, u=np.ones((t.size, 1))).plot(
+        state_names=["position y", "velocity y'"], state_units=["m", "m/s"],
+        input_names=["force u"], input_units="N", title=title)
+
+
+def _grid_with_wide_labels():
+    fig, axes = plt.subplots(2, 2, figsize=(9, 6), sharey="row")
+    t = np.linspace(0, 10, 50)
+    axes[0, 0].plot(t, 13439.16 * t)
+    axes[0, 0].set(ylabel="balance [DKK]", title="two\nlines")
+    axes[0, 1].semilogy(t, 1e-10 + t**4)
+    axes[1, 0].plot(t, -1e-5 * t)                 # an offset/exponent text above the axis
+    axes[1, 0].set(xlabel="time t [s]", ylabel="tiny\n[m]")
+    axes[1, 1].plot(t, np.sin(t))
+    axes[1, 1].set(xlabel="time t [s]", title="right column")
+    fig.suptitle("A suptitle over a 2 x 2 grid")
+    return ck.fit_margins(fig)
+
+
+def _state_plane():
+    x = np.column_stack([np.cos(np.linspace(0, 6, 100)), np.sin(np.linspace(0, 6, 100))])
+    return ck.plot_state_plane(x, labels=["circle"], title="State plane")
+
+
+FIGURES = {"response": _response, "grid": _grid_with_wide_labels, "state plane": _state_plane}
+
+
+def _drawn_tick_labels(axis, coord):
+    """Tick labels inside the view (matplotlib keeps, but does not draw, the others)."""
+    lo, hi = sorted(axis.get_view_interval())
+    return [t for t in axis.get_ticklabels() if lo <= t.get_position()[coord] <= hi]
+
+
+def _text_boxes(fig, renderer):
+    """Window extents of every visible tick label, axis label, title and suptitle."""
+    boxes = []
+    for ax in fig.axes:
+        texts = [ax.title, ax._left_title, ax._right_title, ax.xaxis.label, ax.yaxis.label,
+                 ax.yaxis.get_offset_text(), *_drawn_tick_labels(ax.xaxis, 0), *_drawn_tick_labels(ax.yaxis, 1)]
+        boxes += [(ax, t.get_window_extent(renderer)) for t in texts if t.get_visible() and t.get_text()]
+    boxes += [(None, t.get_window_extent(renderer)) for t in fig.texts if t.get_text()]
+    return boxes
+
+
+@pytest.mark.parametrize("lecture", [False, True], ids=["default fonts", "lecture mode"])
+@pytest.mark.parametrize("name", FIGURES)
+def test_every_label_fits_inside_the_figure_without_overlapping_another_axes(name, lecture):
+    ck.lecture_mode(lecture)
+    try:
+        fig = FIGURES[name]()
+        renderer = _draw(fig)
+        width, height = fig.canvas.get_width_height()
+        for owner, box in _text_boxes(fig, renderer):
+            assert box.x0 >= -0.5 and box.y0 >= -0.5, f"{name}: text sticks out left/below: {box}"
+            assert box.x1 <= width + 0.5 and box.y1 <= height + 0.5, f"{name}: text sticks out right/above: {box}"
+            for ax in fig.axes:
+                if owner is not None and ax is not owner:
+                    inside = ax.get_window_extent(renderer)
+                    assert not box.overlaps(inside), f"{name}: a label of one axes overlaps another axes"
+    finally:
+        ck.lecture_mode(False)
+        plt.close("all")
+
+
+@pytest.mark.parametrize("name", FIGURES)
+def test_margins_are_close_to_what_constrained_layout_measures(name):
+    fig = FIGURES[name]()
+    _draw(fig)
+    ours = sum(ax.get_position().width * ax.get_position().height for ax in fig.axes)
+    fig.set_layout_engine("constrained")
+    _draw(fig)
+    measured = sum(ax.get_position().width * ax.get_position().height for ax in fig.axes)
+    plt.close("all")
+    assert ours >= 0.85 * measured, f"{name}: estimated margins waste space ({ours:.3f} vs {measured:.3f})"
+
+
+def test_layout_adapts_when_a_title_is_added_after_the_figure_is_built():
+    fig = _state_plane()
+    fig.axes[0].set_title("")
+    _draw(fig)
+    top_before = fig.subplotpars.top
+    fig.axes[0].set_title("a title\nover two lines")
+    _draw(fig)
+    assert fig.subplotpars.top < top_before - 0.05
+    plt.close("all")
+
+
+def test_a_suptitle_wider_than_the_figure_is_wrapped_and_given_room():
+    fig = _response(title="A very long suptitle " * 6)
+    renderer = _draw(fig)
+    width, height = fig.canvas.get_width_height()
+    box = fig.texts[0].get_window_extent(renderer)
+    assert box.x0 >= 0 and box.x1 <= width and box.y1 <= height
+    top_axes = max(ax.get_window_extent(renderer).y1 for ax in fig.axes)
+    assert box.y0 > top_axes
+    plt.close("all")
