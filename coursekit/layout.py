@@ -62,6 +62,7 @@ def _make_engine_class():
 
 
 def _apply(fig) -> None:
+    """Set the margins and gaps of the figure's axes grid from their estimated needs."""
     axes = [ax for ax in fig.axes if ax.get_visible() and ax.get_subplotspec() is not None]
     if not axes:
         return

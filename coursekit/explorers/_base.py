@@ -58,12 +58,10 @@ def dropdown(options, value, description: str):
 def figure_png(fig) -> bytes:
     """Render a matplotlib figure to PNG bytes, at the figure's dpi.
 
-    One Agg draw (which also runs the figure's layout engine) and a PNG
-    encode: `savefig` would draw a constrained-layout figure twice, once
-    without rendering to place the axes and once to render, which makes every
-    slider move (and the first display) about a third slower for the same
-    picture. The Agg canvas is attached to the figure once and reused, so its
-    renderer is kept between slider moves.
+    One Agg draw (which also runs the figure's layout engine, see
+    `coursekit.layout.fit_margins`) and a PNG encode, without the extra
+    passes `savefig` may make. The Agg canvas is attached to the figure once
+    and reused, so its renderer is kept between slider moves.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.image import imsave
