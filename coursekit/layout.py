@@ -6,8 +6,10 @@ the figure again; with a dozen figures per notebook and a redraw per slider
 move, measuring dominates. The space an axes grid needs follows closely from
 the font sizes, the number of text lines and the characters of the tick
 labels, so `fit_margins` estimates it without rendering any text and sets
-it with ``subplots_adjust`` each time the figure is drawn. Larger fonts
-(lecture mode) give larger margins by the same rule.
+it with ``subplots_adjust`` each time the figure is drawn. In lecture mode the
+fonts are so large that legends and titles can outgrow their axes, which the
+estimate does not model, so there the figure is measured (constrained layout)
+instead: slower, but right on the projector.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ def fit_margins(fig):
     titles and suptitle -- without measuring text -- and applies them with
     ``subplots_adjust``. Call it once on any figure whose axes come from
     ``plt.subplots`` or a GridSpec; every figure coursekit draws uses it.
+    In lecture mode it lays the figure out with constrained layout instead.
     Returns the figure.
     """
     global _engine_class
@@ -48,15 +51,23 @@ def fit_margins(fig):
 
 def _make_engine_class():
     """The LayoutEngine subclass, defined on first use (matplotlib loads lazily)."""
-    from matplotlib.layout_engine import LayoutEngine
+    from matplotlib.layout_engine import ConstrainedLayoutEngine, LayoutEngine
+
+    from .style import is_lecture_mode
 
     class EstimatedMargins(LayoutEngine):
-        """Margins and gaps from `_axes_needs`, set with subplots_adjust at each draw."""
+        """Margins and gaps from `_axes_needs`, set with subplots_adjust at each draw;
+        measured by constrained layout in lecture mode."""
         _adjust_compatible = True
         _colorbar_gridspec = False
 
         def execute(self, fig):
-            _apply(fig)
+            if is_lecture_mode():
+                for ax in fig.axes:
+                    ax.title.set_wrap(True)  # a title wider than the figure breaks into lines
+                ConstrainedLayoutEngine().execute(fig)
+            else:
+                _apply(fig)
 
     return EstimatedMargins
 

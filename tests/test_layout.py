@@ -47,7 +47,13 @@ def _state_plane():
     return ck.plot_state_plane(x, labels=["circle"], title="State plane")
 
 
-FIGURES = {"response": _response, "grid": _grid_with_wide_labels, "state plane": _state_plane}
+def _explorer():
+    from coursekit.explorers import ch3
+    return ch3.pole_placement_explorer().fig
+
+
+FIGURES = {"response": _response, "grid": _grid_with_wide_labels, "state plane": _state_plane,
+           "explorer": _explorer}
 
 
 def _drawn_tick_labels(axis, coord):
@@ -63,6 +69,8 @@ def _text_boxes(fig, renderer):
         texts = [ax.title, ax._left_title, ax._right_title, ax.xaxis.label, ax.yaxis.label,
                  ax.yaxis.get_offset_text(), *_drawn_tick_labels(ax.xaxis, 0), *_drawn_tick_labels(ax.yaxis, 1)]
         boxes += [(ax, t.get_window_extent(renderer)) for t in texts if t.get_visible() and t.get_text()]
+        if ax.get_legend() is not None:
+            boxes.append((ax, ax.get_legend().get_window_extent(renderer)))
     boxes += [(None, t.get_window_extent(renderer)) for t in fig.texts if t.get_text()]
     return boxes
 
@@ -82,6 +90,9 @@ def test_every_label_fits_inside_the_figure_without_overlapping_another_axes(nam
                 if owner is not None and ax is not owner:
                     inside = ax.get_window_extent(renderer)
                     assert not box.overlaps(inside), f"{name}: a label of one axes overlaps another axes"
+            for other, other_box in _text_boxes(fig, renderer):
+                if owner is not None and other is not None and other is not owner:
+                    assert not box.overlaps(other_box), f"{name}: labels of two axes overlap: {box}, {other_box}"
     finally:
         ck.lecture_mode(False)
         plt.close("all")
