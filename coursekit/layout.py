@@ -113,8 +113,8 @@ def _axes_needs(ax) -> list:
     """[left, right, bottom, top]: points of text and ticks outside the axes box."""
     need = [0.0, 0.0, 0.0, 0.0]
     if ax.axison:
-        _add_axis(ax.yaxis, need, sides=(0, 1), overhang=(2, 3))
-        _add_axis(ax.xaxis, need, sides=(2, 3), overhang=(0, 1))
+        _add_axis(ax.yaxis, need, sides=(0, 1), overhang=3)
+        _add_axis(ax.xaxis, need, sides=(2, 3), overhang=1)
     titles = [ax.get_title(loc) for loc in ("left", "center", "right")]
     lines = max(_lines(text) for text in titles)
     if lines:
@@ -123,8 +123,9 @@ def _axes_needs(ax) -> list:
     return need
 
 
-def _add_axis(axis, need: list, sides, overhang) -> None:
-    """Add one axis' tick labels, ticks and label to `need` (in place)."""
+def _add_axis(axis, need: list, sides, overhang: int) -> None:
+    """Add one axis' tick labels, ticks and label to `need` (in place); `overhang` is the
+    side (top for y, right for x) past which the last tick label sticks out."""
     labels = _tick_labels(axis)
     tick = axis.get_major_ticks(1)[0] if labels else None
     vertical = axis.axis_name == "y"
@@ -136,9 +137,9 @@ def _add_axis(axis, need: list, sides, overhang) -> None:
         need[side] += tick.get_tick_padding() + tick.get_pad() + across
         # the first and last labels stick out past the axes' ends by half their length
         half = (0.5 * _LINE * size if vertical else 0.5 * _width(labels[-1], size))
-        need[overhang[1]] = max(need[overhang[1]], half)
+        need[overhang] = max(need[overhang], half)
         if vertical and axis.major.formatter.get_offset():
-            need[overhang[1]] = max(need[overhang[1]], _LINE * size)  # the 1e-5 above the axis
+            need[overhang] = max(need[overhang], _LINE * size)  # the 1e-5 above the axis
     text = axis.label.get_text()
     if text:
         side = sides[0] if axis.get_label_position() in ("left", "bottom") else sides[1]

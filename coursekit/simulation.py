@@ -366,7 +366,7 @@ def _first_order(a, v: np.ndarray) -> np.ndarray:
     overwritten.
     """
     from scipy.linalg import lapack
-    cplx = np.iscomplexobj(v) or isinstance(a, complex) or np.iscomplexobj(a)
+    cplx = np.iscomplexobj(v) or np.iscomplexobj(a)
     dtype = complex if cplx else float
     band = np.empty((2, v.size), dtype=dtype)  # band storage: diagonal row, then the row below
     band[0] = 1.0
