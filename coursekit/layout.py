@@ -28,48 +28,67 @@ _LINE = 1.25         # height of a text line, in font sizes
 _EDGE = 4.0          # points kept free at the figure's edge
 _SUPERSCRIPT = 0.7   # size of mathtext superscripts (log-axis labels 10^k)
 
-_engine_class = None
+_hook_class = None
 
 
 def fit_margins(fig):
     """Lay the figure's grid of axes out by estimated margins (fast, one draw).
 
-    Attaches a layout engine that, each time the figure is drawn, sizes the
-    margins and the gaps between axes from the tick labels, axis labels,
-    titles and suptitle -- without measuring text -- and applies them with
-    ``subplots_adjust``. Call it once on any figure whose axes come from
-    ``plt.subplots`` or a GridSpec; every figure coursekit draws uses it.
-    In lecture mode it lays the figure out with constrained layout instead.
-    Returns the figure.
+    Adds to the figure an invisible artist that, each time the figure is
+    drawn and before any axes is, sizes the margins and the gaps between axes
+    from the tick labels, axis labels, titles and suptitle -- without
+    measuring text -- and applies them with ``subplots_adjust``. Call it once
+    on any figure whose axes come from ``plt.subplots`` or a GridSpec (calling
+    it again changes nothing); every figure coursekit draws uses it. In
+    lecture mode the figure is laid out by constrained layout instead. A
+    layout engine set on the figure (``fig.set_layout_engine``) takes
+    precedence. Returns the figure.
+
+    Not a matplotlib layout engine on purpose: a figure with an engine is
+    drawn twice by ``savefig`` and by the notebook's inline backend (once to
+    lay it out, once to render it), and the first pass costs nearly as much
+    as the second.
     """
-    global _engine_class
-    if _engine_class is None:
-        _engine_class = _make_engine_class()
-    fig.set_layout_engine(_engine_class())
+    global _hook_class
+    if _hook_class is None:
+        _hook_class = _make_hook_class()
+    if not any(isinstance(artist, _hook_class) for artist in fig.artists):
+        fig.add_artist(_hook_class())
     return fig
 
 
-def _make_engine_class():
-    """The LayoutEngine subclass, defined on first use (matplotlib loads lazily)."""
-    from matplotlib.layout_engine import ConstrainedLayoutEngine, LayoutEngine
+def _make_hook_class():
+    """The Artist subclass, defined on first use (matplotlib loads lazily)."""
+    from matplotlib.artist import Artist
+    from matplotlib.layout_engine import ConstrainedLayoutEngine
 
     from .style import is_lecture_mode
 
-    class EstimatedMargins(LayoutEngine):
-        """Margins and gaps from `_axes_needs`, set with subplots_adjust at each draw;
-        measured by constrained layout in lecture mode."""
-        _adjust_compatible = True
-        _colorbar_gridspec = False
+    class MarginsAtDraw(Artist):
+        """Draws nothing; sets the margins of its figure's axes as the figure is drawn.
 
-        def execute(self, fig):
+        Its zorder puts it before every axes in the figure's drawing order, and
+        it takes no part in tight bounding boxes.
+        """
+
+        def __init__(self):
+            super().__init__()
+            self.set_zorder(-math.inf)
+            self.set_in_layout(False)
+
+        def draw(self, renderer):
+            fig = self.get_figure()
+            if fig is None or fig.get_layout_engine() is not None:
+                return
             if is_lecture_mode():
                 for ax in fig.axes:
                     ax.title.set_wrap(True)  # a title wider than the figure breaks into lines
                 ConstrainedLayoutEngine().execute(fig)
             else:
                 _apply(fig)
+            self.stale = False
 
-    return EstimatedMargins
+    return MarginsAtDraw
 
 
 def _apply(fig) -> None:

@@ -130,3 +130,41 @@ def test_a_suptitle_wider_than_the_figure_is_wrapped_and_given_room():
     top_axes = max(ax.get_window_extent(renderer).y1 for ax in fig.axes)
     assert box.y0 > top_axes
     plt.close("all")
+
+
+def test_fit_margins_lays_the_figure_out_in_the_one_draw_that_renders_it(monkeypatch):
+    # a matplotlib layout engine would make savefig (and the inline backend) draw twice
+    import io
+    from coursekit import layout
+    calls = []
+    monkeypatch.setattr(layout, "_apply", lambda fig: calls.append(fig))
+    fig = _grid_with_wide_labels()
+    assert fig.get_layout_engine() is None
+    fig.savefig(io.BytesIO(), format="png")
+    assert calls == [fig]
+    plt.close("all")
+
+
+def test_fit_margins_twice_adds_one_hook_that_tight_bounding_boxes_ignore():
+    fig = _grid_with_wide_labels()
+    ck.fit_margins(fig)
+    assert len(fig.artists) == 1
+    assert fig.artists[0] not in fig.get_default_bbox_extra_artists()
+    renderer = _draw(fig)
+    tight = fig.get_tightbbox(renderer)
+    assert tight.x0 > 0 and tight.y0 > 0, "the invisible hook must not pull the tight box to (0, 0)"
+    plt.close("all")
+
+
+@pytest.mark.filterwarnings("error")  # subplots_adjust on a constrained figure only warns
+def test_a_layout_engine_set_on_the_figure_takes_precedence():
+    fig = _grid_with_wide_labels()
+    fig.set_layout_engine("constrained")
+    _draw(fig)
+    ours = [ax.get_position().bounds for ax in fig.axes]
+    reference = _grid_with_wide_labels()
+    reference.artists[0].remove()
+    reference.set_layout_engine("constrained")
+    _draw(reference)
+    assert np.allclose(ours, [ax.get_position().bounds for ax in reference.axes])
+    plt.close("all")

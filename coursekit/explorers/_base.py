@@ -58,7 +58,7 @@ def dropdown(options, value, description: str):
 def figure_png(fig) -> bytes:
     """Render a matplotlib figure to PNG bytes, at the figure's dpi.
 
-    One Agg draw (which also runs the figure's layout engine, see
+    One Agg draw (which also sets the margins, see
     `coursekit.layout.fit_margins`) and a PNG encode, without the extra
     passes `savefig` may make. The Agg canvas is attached to the figure once
     and reused, so its renderer is kept between slider moves.
