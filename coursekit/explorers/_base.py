@@ -61,14 +61,17 @@ def figure_png(fig) -> bytes:
     One Agg draw (which also sets the margins, see
     `coursekit.layout.fit_margins`) and a PNG encode, without the extra
     passes `savefig` may make. The Agg canvas is attached to the figure once
-    and reused, so its renderer is kept between slider moves.
+    and reused, so its renderer is kept between slider moves. zlib level 1
+    encodes in about half the time of the default level, for a PNG about
+    15 % larger.
     """
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.image import imsave
     canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
     canvas.draw()
     buf = io.BytesIO()
-    imsave(buf, canvas.buffer_rgba(), format="png", dpi=fig.dpi)
+    imsave(buf, canvas.buffer_rgba(), format="png", dpi=fig.dpi,
+           pil_kwargs={"compress_level": 1})
     return buf.getvalue()
 
 
