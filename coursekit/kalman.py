@@ -28,7 +28,11 @@ Integration: both filters use the classical fixed-step Runge-Kutta method
 (RK4) between the samples of the grid, with u and y linear between samples
 (as `simulate` does). A step is split automatically when the Riccati
 equation is fast compared with the grid (large P or small R), so the filter
-stays stable on coarse grids.
+stays stable on coarse grids. For the linear filter (4.88) does not involve
+the data: P(t) is integrated first, then the estimate, whose RK4 steps are
+affine maps built for all steps at once. The EKF's numerical Jacobians call
+f and h once per evaluation on a batch of perturbed states when they accept
+one (all `coursekit.models` do).
 """
 
 from __future__ import annotations
@@ -40,7 +44,7 @@ from typing import Callable
 import numpy as np
 
 from ._validation import as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
-from .linearization import _jacobian
+from .linearization import _jacobian, _perturbed, _quotients
 from .observability import _obs_pair
 from .simulation import SimulationResult, lti_step_matrices
 from .systems import NonlinearSystem, StateSpace
@@ -154,7 +158,12 @@ def _records(t, u, y, m: int):
 def _riccati_rate(A: np.ndarray, L: np.ndarray, C: np.ndarray) -> float:
     """How fast (4.88) moves near P: its linearization is dP' = (A - L C) dP + dP (A - L C)^T,
     whose eigenvalues are sums of two eigenvalues of A - L C."""
-    return 2.0 * float(np.abs(np.linalg.eigvals(A - L @ C)).max())
+    return _closed_loop_rate(A - L @ C)
+
+
+def _closed_loop_rate(M: np.ndarray) -> float:
+    """`_riccati_rate` from M = A - L C: twice the largest |eigenvalue| of M."""
+    return 2.0 * float(np.abs(np.linalg.eigvals(M)).max())
 
 
 def _radius_bound(M: np.ndarray) -> float:
@@ -174,93 +183,228 @@ def _radius_bound(M: np.ndarray) -> float:
 
 
 def _step_length(A: np.ndarray, L: np.ndarray, C: np.ndarray, h_max: float) -> float:
-    """min(h_max, 0.5 / rate) with the rate of `_riccati_rate`.
+    """min(h_max, 0.5 / rate) with the rate of `_riccati_rate`."""
+    return _closed_loop_step(A - L @ C, h_max)
+
+
+def _closed_loop_step(M: np.ndarray, h_max: float) -> float:
+    """`_step_length` from M = A - L C, which the filters have at hand.
 
     The eigenvalues are only computed when they can matter: when even an
     upper bound of the rate allows h_max, the rate itself does too, and h_max
     is returned as is.
     """
-    if 4.0 * h_max * _radius_bound(A - L @ C) >= 1.0:
-        return min(h_max, 0.5 / max(_riccati_rate(A, L, C), 1e-300))
+    if 4.0 * h_max * _radius_bound(M) >= 1.0:
+        return min(h_max, 0.5 / max(_closed_loop_rate(M), 1e-300))
     return h_max
 
 
-def _finite(x: np.ndarray, P: np.ndarray) -> bool:
-    """True when no entry of x or P is inf or nan (a sum is finite only then)."""
-    return bool(np.isfinite(x.sum() + P.sum()))
+def _finite(a: np.ndarray, b: np.ndarray | None = None) -> bool:
+    """True when no entry of a (and b) is inf or nan (a sum is finite only then)."""
+    total = np.add.reduce(a, None)
+    return math.isfinite(total if b is None else total + np.add.reduce(b, None))
 
 
 _MAX_STEPS = 100_000
 
 
-def _rk4_interval(rhs, x, P, cur, u0, u1, y0, y1, dt: float, substeps: int):
-    """RK4 from one sample to the next, with u and y linear in between.
+def _next_step(tau: float, dt: float, substeps: int, M: np.ndarray) -> float:
+    """Length of the RK4 step from tau inside a sample interval of length dt.
+
+    At most dt / substeps and at most 0.5 / rate (`_step_length`, the rate of
+    (4.88) at the current P, M = A - L C); stretched to the end of the
+    interval when within 1e-9 dt of it.
+    """
+    h = _closed_loop_step(M, min(dt - tau, dt / substeps))
+    return dt - tau if dt - tau - h < 1e-9 * dt else h
+
+
+def _advance(tau: float, h: float, dt: float, steps: int) -> tuple[float, int]:
+    """(tau, steps) after a step of length h; RuntimeError past _MAX_STEPS steps."""
+    steps += 1
+    if steps > _MAX_STEPS:
+        raise RuntimeError(
+            f"the Riccati equation (4.88) needs more than {_MAX_STEPS} RK4 steps between two "
+            "samples (its rate is huge): check the units of Q and R (module docstring), or "
+            "start from a smaller P0.")
+    return (dt if h == dt - tau else tau + h), steps
+
+
+def _diverged(t_k: float) -> RuntimeError:
+    return RuntimeError(
+        f"the filter diverged at t={t_k:g} (non-finite estimate or P); check the "
+        "model, the units of Q and R, and try substeps=10.")
+
+
+def _rk4_interval(rhs, x, P, cur, w0, w1, dt: float, substeps: int):
+    """RK4 on (4.91) and (4.88) from one sample to the next, w = [u, y] linear in between.
 
     The step is at most dt / substeps and at most 0.5 / rate, the rate of
     (4.88) at the current P, so a fast start (large P0, small R) takes many
     short steps that lengthen as P settles. `cur` is rhs at the start; the
-    value at the end is returned for the next interval.
+    value at the end is returned for the next interval, or None when x or P
+    stopped being finite (the caller reports the divergence).
     """
-    tau, steps = 0.0, 0
-    du, dy = u1 - u0, y1 - y0
+    tau, steps, dw = 0.0, 0, w1 - w0
     while tau < dt:
-        _, _, L, A, C = cur
-        h = _step_length(A, L, C, min(dt - tau, dt / substeps))
-        if dt - tau - h < 1e-9 * dt:
-            h = dt - tau
-        # u and y linear over the interval: u0 + s (u1 - u0) at s = (tau + h/2)/dt and (tau + h)/dt
-        s_mid, s_end = (tau + h / 2) / dt, (tau + h) / dt
-        um, ue = u0 + s_mid * du, u0 + s_end * du
-        ym, ye = y0 + s_mid * dy, y0 + s_end * dy
-        k1 = cur[:2]
-        k2 = rhs(x + h / 2 * k1[0], P + h / 2 * k1[1], um, ym)[:2]
-        k3 = rhs(x + h / 2 * k2[0], P + h / 2 * k2[1], um, ym)[:2]
-        k4 = rhs(x + h * k3[0], P + h * k3[1], ue, ye)[:2]
-        x = x + h / 6 * (k1[0] + 2 * k2[0] + 2 * k3[0] + k4[0])
-        P = P + h / 6 * (k1[1] + 2 * k2[1] + 2 * k3[1] + k4[1])
+        k1x, k1P, _, M = cur
+        h = _next_step(tau, dt, substeps, M)
+        # w linear over the interval: w0 + s (w1 - w0) at s = (tau + h/2)/dt and (tau + h)/dt
+        w_mid, w_end = w0 + (tau + h / 2) / dt * dw, w0 + (tau + h) / dt * dw
+        k2x, k2P, _, _ = rhs(x + h / 2 * k1x, P + h / 2 * k1P, w_mid)
+        k3x, k3P, _, _ = rhs(x + h / 2 * k2x, P + h / 2 * k2P, w_mid)
+        k4x, k4P, _, _ = rhs(x + h * k3x, P + h * k3P, w_end)
+        x = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x)
+        P = P + h / 6 * (k1P + 2 * k2P + 2 * k3P + k4P)
         P = (P + P.T) / 2
         if not _finite(x, P):
-            break                                   # the caller reports the divergence
-        steps += 1
-        if steps > _MAX_STEPS:
-            raise RuntimeError(
-                f"the Riccati equation (4.88) needs more than {_MAX_STEPS} RK4 steps between two "
-                "samples (its rate is huge): check the units of Q and R (module docstring), or "
-                "start from a smaller P0.")
-        tau = dt if h == dt - tau else tau + h
-        cur = rhs(x, P, ue, ye)
+            return x, P, None
+        tau, steps = _advance(tau, h, dt, steps)
+        cur = rhs(x, P, w_end)
     return x, P, cur
 
 
-def _run_filter(f, h, dfdx, dhdx, t, u, y, Q, R, P0, x0, substeps: int) -> KalmanResult:
-    """Integrate (4.86)/(4.91) and (4.87)-(4.88) with RK4 on the grid t."""
-    n, N = x0.size, t.size
+def _ekf_rhs(model, Q, R, m: int):
+    """rhs(x, P, w) -> (x̂', P', L, A - L C) of (4.91), (4.88), (4.87) at w = [u, y].
+
+    Products are written ``a.dot(b)``: the same numbers as ``a @ b``, with half
+    the call overhead on these small arrays (rhs runs four times per RK4 step).
+    """
     Rinv = np.linalg.inv(R)
 
-    def rhs(x, P, uk, yk):
-        A, C = dfdx(x, uk), dhdx(x, uk)
+    def rhs(x, P, w):
+        u, y = w[:m], w[m:]
+        fx, hx, A, C = model(x, u)
         # (4.87): L = P C^T R^{-1}
-        L = P @ C.T @ Rinv
-        # (4.86), (4.91): x̂' = f(x̂, u) + L (y - h(x̂, u))
-        dx = f(x, uk) + L @ (yk - h(x, uk))
-        # (4.88): Ṗ = A P + P A^T - P C^T R^{-1} C P + Q
-        dP = A @ P + P @ A.T - L @ C @ P + Q
-        return dx, dP, L, A, C
+        L = P.dot(C.T).dot(Rinv)
+        # (4.91): x̂' = f(x̂, u) + L (y - h(x̂, u))
+        dx = fx + L.dot(y - hx)
+        # (4.88): Ṗ = A P + P A^T - P C^T R^{-1} C P + Q = (A - L C) P + P A^T + Q
+        M = A - L.dot(C)
+        return dx, M.dot(P) + P.dot(A.T) + Q, L, M
+    return rhs
 
-    xs, Ps, Ls = np.empty((N, n)), np.empty((N, n, n)), np.empty((N, n, y.shape[1]))
+
+def _run_filter(rhs, t, w, P0, x0, substeps: int) -> KalmanResult:
+    """Integrate (4.91) and (4.87)-(4.88) with RK4 on the grid t (w = [u, y] per sample)."""
+    N = t.size
     x, P = x0.copy(), P0.copy()
-    cur = rhs(x, P, u[0], y[0])
-    for k in range(N):
+    cur = rhs(x, P, w[0])
+    xs, Ps, Ls = np.empty((N,) + x.shape), np.empty((N,) + P.shape), np.empty((N,) + cur[2].shape)
+    for k, dt in enumerate(np.diff(t).tolist()):
         xs[k], Ps[k], Ls[k] = x, P, cur[2]
-        if k + 1 == N:
-            break
-        x, P, cur = _rk4_interval(rhs, x, P, cur, u[k], u[k + 1], y[k], y[k + 1],
-                                  t[k + 1] - t[k], substeps)
-        if not _finite(x, P):
-            raise RuntimeError(
-                f"the filter diverged at t={t[k + 1]:g} (non-finite estimate or P); check the "
-                "model, the units of Q and R, and try substeps=10.")
+        x, P, cur = _rk4_interval(rhs, x, P, cur, w[k], w[k + 1], dt, substeps)
+        if cur is None:
+            raise _diverged(t[k + 1])
+    xs[-1], Ps[-1], Ls[-1] = x, P, cur[2]
     return KalmanResult(t=t, x=xs, P=Ps, L=Ls)
+
+
+def _riccati_interval(riccati, P, cur, dt: float, substeps: int):
+    """RK4 on (4.88) alone over one sample interval, with the steps of `_rk4_interval`.
+
+    `cur` = riccati(P) = (P', A - L C) at the start. Returns (P, cur, steps)
+    at the end, cur None if P stopped being finite, and for each step
+    (s_mid, s_end, h, P1, P2, P3, P4): the stage positions as fractions of
+    the interval, the length and P at the four stages.
+    """
+    tau, count, steps = 0.0, 0, []
+    while tau < dt:
+        k1, M = cur
+        h = _next_step(tau, dt, substeps, M)
+        P2 = P + h / 2 * k1
+        k2 = riccati(P2)[0]
+        P3 = P + h / 2 * k2
+        k3 = riccati(P3)[0]
+        P4 = P + h * k3
+        k4 = riccati(P4)[0]
+        steps.append(((tau + h / 2) / dt, (tau + h) / dt, h, P, P2, P3, P4))
+        P = P + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+        P = (P + P.T) / 2
+        if not _finite(P):
+            return P, None, steps
+        tau, count = _advance(tau, h, dt, count)
+        cur = riccati(P)
+    return P, cur, steps
+
+
+def _riccati_pass(A, C, Q, G, t, P0, substeps: int):
+    """P(t) of (4.88) on the grid t and the RK4 steps taken, for constant A and C.
+
+    (4.88) does not involve the data, so it is integrated first, alone; the
+    gain is L = P G (4.87), G = C^T R^{-1}.
+    Returns P at the samples (N, n, n) and the steps as
+    (k, s_mid, s_end, h, P1, P2, P3, P4), k the sample interval (`_riccati_interval`).
+    (4.88) is autonomous: an interval depends on P and dt only, and once P
+    has settled to a fixed point of the RK4 step (to the last bit) the
+    interval is reused instead of recomputed.
+    """
+    S, AT = G @ C, A.T.copy()
+
+    def riccati(P):
+        M = A - P.dot(S)                                # A - L C, with L = P C^T R^{-1} (4.87)
+        return M.dot(P) + P.dot(AT) + Q, M              # (4.88) = (A - L C) P + P A^T + Q
+
+    Ps, steps, settled = np.empty((t.size,) + P0.shape), [], {}
+    P, cur = P0.copy(), riccati(P0)
+    for k, dt in enumerate(np.diff(t).tolist()):
+        Ps[k] = P
+        key = (dt, P.tobytes())
+        P, cur, taken = settled.get(key) or _riccati_interval(riccati, P, cur, dt, substeps)
+        if cur is None:
+            raise _diverged(t[k + 1])
+        if key[1] == P.tobytes():
+            settled[key] = P, cur, taken
+        steps += [(k,) + step for step in taken]
+    Ps[-1] = P
+    return Ps, steps
+
+
+def _rk4_affine(M: np.ndarray, g: np.ndarray, h: np.ndarray):
+    """(Φ, c) with x + (RK4 step of x' = M_i x + g_i) = Φ x + c, for many steps at once.
+
+    M (J, 4, n, n) and g (J, 4, n) are the matrix and the forcing at the four
+    stages of each of J steps of lengths h (J,); returns Φ (J, n, n), c (J, n).
+    Each stage derivative k_i = K_i x + d_i is affine in the state x at the
+    start of the step, and so is the stage state x + a h k_i of the next one.
+    """
+    I, H = np.eye(M.shape[-1]), h[:, None, None]
+    E, e = I, np.zeros_like(g[:, 0])                    # stage state E x + e, first x itself
+    K_sum, d_sum = 0.0, 0.0
+    for i, weight in enumerate((1.0, 2.0, 2.0, 1.0)):
+        K = M[:, i] @ E                                 # k_i = K x + d
+        d = np.einsum("jab,jb->ja", M[:, i], e) + g[:, i]
+        K_sum, d_sum = K_sum + weight * K, d_sum + weight * d
+        if i < 3:                                       # next stage state x + a h k_i
+            a = (0.5, 0.5, 1.0)[i] * H
+            E, e = I + a * K, a[:, 0] * d
+    # x + h/6 (k1 + 2 k2 + 2 k3 + k4)
+    return I + H / 6 * K_sum, H[:, 0] / 6 * d_sum
+
+
+def _estimate_pass(sys, G, w, x0, steps):
+    """x̂ of (4.86) at the samples (N, n), through the RK4 steps of `_riccati_pass`.
+
+    With the gain L_i of each stage, (4.86) is x̂' = M_i x̂ + g_i, M_i = A - L_i C,
+    g_i = B u_i + L_i (y_i - D u_i): affine, so each RK4 step is x̂ <- Φ x̂ + c
+    (`_rk4_affine`). Φ and c are built for all steps at once; the loop then
+    does one product per step.
+    """
+    k, s_mid, s_end, h, *stages = (np.array(column) for column in zip(*steps))
+    L = np.stack(stages, axis=1) @ G                  # (4.87) at the stages, (J, 4, n, p)
+    w0, dw = w[k], (w[1:] - w[:-1])[k]
+    w_mid, w_end = w0 + s_mid[:, None] * dw, w0 + s_end[:, None] * dw
+    # stage 1 sees w where the previous step ended (w[0] for the first step)
+    W = np.stack([np.vstack([w[:1], w_end[:-1]]), w_mid, w_mid, w_end], axis=1)
+    u, y = W[..., :sys.m], W[..., sys.m:]
+    g = u @ sys.B.T + np.einsum("jiab,jib->jia", L, y - u @ sys.D.T)
+    Phi, c = _rk4_affine(sys.A - L @ sys.C, g, h)
+    x, after = x0, np.empty((k.size, x0.size))
+    for j in range(k.size):
+        x = Phi[j].dot(x) + c[j]
+        after[j] = x
+    last = np.append(k[1:] != k[:-1], True)                       # the last step of each interval
+    return np.vstack([x0, after[last]])
 
 
 def _substeps(substeps) -> int:
@@ -296,10 +440,67 @@ def kalman_bucy(sys, t, u, y, Q, R, P0, x0, *, substeps: int = 1) -> KalmanResul
         raise ValueError(f"y has the wrong number of columns: received {y.shape[1]}, "
                          f"expected {sys.p} (one per output, since C has {sys.p} rows).")
     Q, R, P0, x0 = _filter_setup(sys.n, sys.p, Q, R, P0, x0)
-    A, B, C, D = sys.A, sys.B, sys.C, sys.D
-    return _run_filter(lambda x, v: A @ x + B @ v, lambda x, v: C @ x + D @ v,
-                       lambda x, v: A, lambda x, v: C, t, u, y, Q, R, P0, x0,
-                       _substeps(substeps))
+    G = sys.C.T @ np.linalg.inv(R)                      # L = P G (4.87)
+    Ps, steps = _riccati_pass(sys.A, sys.C, Q, G, t, P0, _substeps(substeps))
+    xs = _estimate_pass(sys, G, np.hstack([u, y]), x0, steps)
+    finite = np.isfinite(xs).all(axis=1)
+    if not finite.all():
+        raise _diverged(t[np.argmin(finite)])
+    return KalmanResult(t=t, x=xs, P=Ps, L=Ps @ G)
+
+
+def _accepts_batches(fun, x0: np.ndarray, u0: np.ndarray) -> bool:
+    """True when fun(X, U), states and inputs as columns, agrees column by column with
+    fun(x, u) on single states (within 1e-12), checked on the states of `_perturbed(x0)`.
+
+    Like `simulation._check_batch`, but a function written for one state at a
+    time (``float(x[0])``, ``if x[0] > 0``, ...) is an answer, not an error.
+    """
+    X, _ = _perturbed(x0)
+    single = np.column_stack([np.ravel(fun(X[:, j], u0)) for j in range(X.shape[1])])
+    try:
+        batch = np.asarray(fun(X, u0[:, None].repeat(X.shape[1], axis=1)), dtype=float)
+    except Exception:                   # written for one state at a time
+        return False
+    return batch.size == single.size and np.allclose(batch.reshape(single.shape), single,
+                                                     rtol=1e-12, atol=1e-12)
+
+
+def _batched_model(f, h, n: int):
+    """(x, u) -> (f, h, ∂f/∂x, ∂h/∂x) at (x, u) from one call of f and one of h on the
+    batch of `_perturbed(x)`: x and its 2n central-difference neighbours as columns."""
+    cols = 2 * n + 1
+
+    def model(x, u):
+        X, step = _perturbed(x)
+        U = u[:, None].repeat(cols, axis=1)
+        G = np.concatenate((f(X, U).reshape(-1, cols), h(X, U).reshape(-1, cols)))
+        J = _quotients(G, step)
+        return G[:n, -1], G[n:, -1], J[:n], J[n:]
+    return model
+
+
+def _ekf_model(sys, p: int, dfdx, dhdx, x0, u0):
+    """(x, u) -> (f(x, u), h(x, u), A, C), A and C the Jacobians (4.92)-(4.93).
+
+    dfdx and dhdx where given, else central differences (step ~ eps^(1/3),
+    those of `linearize` without its refinement). When both are numerical
+    and f and h accept a batch of states (`_accepts_batches`, checked once
+    here, as it holds for every `coursekit.models` system), each is called
+    once per evaluation (`_batched_model`); otherwise once per perturbed state.
+    """
+    for fun, name in ((dfdx, "dfdx"), (dhdx, "dhdx")):
+        if fun is not None and not callable(fun):
+            raise ValueError(f"{name} must be a function (x, u) -> Jacobian, or None for "
+                             f"numerical differences: received {type(fun).__name__}.")
+    f, h, n = sys.f, sys.h, sys.n
+    if dfdx is None and dhdx is None and _accepts_batches(f, x0, u0) and _accepts_batches(h, x0, u0):
+        return _batched_model(f, h, n)
+    jf = (lambda x, v: np.asarray(dfdx(x, v), float).reshape(n, n)) if dfdx else \
+        (lambda x, v: _jacobian(lambda z: f(z, v), x, refine=False))
+    jh = (lambda x, v: np.asarray(dhdx(x, v), float).reshape(p, n)) if dhdx else \
+        (lambda x, v: _jacobian(lambda z: h(z, v), x, refine=False))
+    return lambda x, v: (f(x, v), h(x, v), jf(x, v), jh(x, v))
 
 
 def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None = None,
@@ -326,15 +527,9 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
     if p_h != y.shape[1]:
         raise ValueError(f"y has the wrong number of columns: received {y.shape[1]}, expected "
                          f"{p_h} (the number of outputs of sys.h).")
-    for fun, name in ((dfdx, "dfdx"), (dhdx, "dhdx")):
-        if fun is not None and not callable(fun):
-            raise ValueError(f"{name} must be a function (x, u) -> Jacobian, or None for "
-                             f"numerical differences: received {type(fun).__name__}.")
-    jf = (lambda x, v: np.asarray(dfdx(x, v), float).reshape(sys.n, sys.n)) if dfdx else \
-        (lambda x, v: _jacobian(lambda z: sys.f(z, v), x, refine=False))
-    jh = (lambda x, v: np.asarray(dhdx(x, v), float).reshape(p_h, sys.n)) if dhdx else \
-        (lambda x, v: _jacobian(lambda z: sys.h(z, v), x, refine=False))
-    return _run_filter(sys.f, sys.h, jf, jh, t, u, y, Q, R, P0, x0, _substeps(substeps))
+    model = _ekf_model(sys, p_h, dfdx, dhdx, x0, u[0])
+    return _run_filter(_ekf_rhs(model, Q, R, sys.m), t, np.hstack([u, y]), P0, x0,
+                       _substeps(substeps))
 
 
 def _rng(seed) -> np.random.Generator:

@@ -13,6 +13,7 @@ The linear model describes the deviations dx = x - x*, du = u - u* (3.61),
 
 from __future__ import annotations
 
+from functools import cache
 from typing import Callable
 
 import numpy as np
@@ -53,6 +54,40 @@ def _central(g: Callable, z: np.ndarray, h: np.ndarray, k: int) -> np.ndarray:
 _CBRT_EPS = float(np.cbrt(np.finfo(float).eps))
 
 
+def _filter_steps(z: np.ndarray) -> np.ndarray:
+    """The steps h_k ~ eps^(1/3) max(1, |z_k|) of the unrefined central difference."""
+    return _CBRT_EPS * np.maximum(1.0, np.abs(z))
+
+
+@cache
+def _signs(n: int) -> np.ndarray:
+    """[I, -I, 0], shape (n, 2n + 1), read-only: the pattern of `_perturbed`."""
+    E = np.hstack([np.eye(n), -np.eye(n), np.zeros((n, 1))])
+    E.flags.writeable = False
+    return E
+
+
+def _perturbed(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(Z, h): the states of the unrefined central difference as the columns of Z (n, 2n + 1).
+
+    Column k is z + h_k e_k, column n + k is z - h_k e_k (the numbers
+    `_jacobian(g, z, refine=False)` evaluates g at, one call each) and the
+    last column is z itself; h = `_filter_steps(z)`.
+    """
+    h = _filter_steps(z)
+    return z[:, None] + _signs(z.size) * h[:, None], h
+
+
+def _quotients(G: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """The Jacobian (q, n) from G (q, 2n + 1), g evaluated on the columns of `_perturbed`.
+
+    Column k is (g(z + h_k e_k) - g(z - h_k e_k)) / (2 h_k), as in `_jacobian(g,
+    z, refine=False)`, from one call of g on a batch instead of 2n calls.
+    """
+    n = h.size
+    return (G[:, :n] - G[:, n:2 * n]) / (2 * h)
+
+
 def _jacobian(g: Callable, z: np.ndarray, *, refine: bool = True) -> np.ndarray:
     """Numerical Jacobian of g at z by central differences.
 
@@ -62,7 +97,7 @@ def _jacobian(g: Callable, z: np.ndarray, *, refine: bool = True) -> np.ndarray:
     need a Jacobian at every step).
     """
     if not refine:
-        h = _CBRT_EPS * np.maximum(1.0, np.abs(z))
+        h = _filter_steps(z)
         return np.column_stack([np.ravel(_central(g, z, h, k)) for k in range(z.size)])
     J = np.empty((np.ravel(g(z)).size, z.size))
     # step ~ eps^(1/5) balances the h^4 truncation and the rounding error

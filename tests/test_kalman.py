@@ -1,5 +1,7 @@
 """kalman_gain, the Kalman-Bucy filter, the EKF and the noise helpers (section 4.7)."""
 
+import math
+
 import control
 import numpy as np
 import pytest
@@ -229,3 +231,114 @@ def test_step_length_shortcut_is_the_exact_rule(n, seed, h_max):
     assert _radius_bound(M) >= np.abs(np.linalg.eigvals(M)).max()
     exact = min(h_max, 0.5 / max(_riccati_rate(A_, L_, C_), 1e-300))
     assert _step_length(A_, L_, C_, h_max) == exact
+
+
+def _ekf_of(sys_, **kw):
+    """The linear system as a NonlinearSystem: the EKF then runs (4.86)-(4.88) step by step."""
+    return ck.NonlinearSystem(lambda x, v: sys_.A @ x + sys_.B @ v, n=sys_.n, m=sys_.m,
+                              h=lambda x, v: sys_.C @ x + sys_.D @ v, **kw)
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(1, 3), st.integers(1, 2), st.integers(0, 2), st.integers(1, 3), st.integers(0, 10_000))
+def test_kalman_bucy_two_passes_equal_the_coupled_integration(n, p, m, substeps, seed):
+    # kalman_bucy integrates P first, then x̂ through affine RK4 steps; the EKF with the exact
+    # Jacobians integrates x̂ and P together, stage by stage. Same RK4, same steps: same numbers.
+    # A large P0 and a small R make the first intervals take many short steps; the uneven grid
+    # repeats a few step lengths, so settled intervals are reused with the right dt.
+    rng = np.random.default_rng(seed)
+    sys_ = ck.StateSpace(rng.normal(size=(n, n)) - np.eye(n), rng.normal(size=(n, m)),
+                         rng.normal(size=(p, n)), rng.normal(size=(p, m)))
+    t = np.concatenate([[0.0], np.cumsum(rng.choice([0.01, 0.02, 0.035], size=200))])
+    u = rng.normal(size=(t.size, m)) if m else None
+    y = rng.normal(size=(t.size, p))
+    G = rng.normal(size=(n, n))
+    Q, R = G @ G.T, np.diag(10 ** rng.uniform(-3, -1, size=p))
+    P0, x0 = 3 * np.eye(n), rng.normal(size=n)
+    kb = ck.kalman_bucy(sys_, t, u, y, Q, R, P0, x0, substeps=substeps)
+    ekf = ck.extended_kalman_filter(_ekf_of(sys_), t, u, y, Q, R, P0, x0, substeps=substeps,
+                                    dfdx=lambda x, v: sys_.A, dhdx=lambda x, v: sys_.C)
+    for a, b in ((kb.x, ekf.x), (kb.P, ekf.P), (kb.L, ekf.L)):
+        np.testing.assert_allclose(a, b, rtol=1e-9, atol=1e-9 * np.abs(b).max())
+
+
+def test_kalman_bucy_long_run_with_settled_riccati():
+    # P reaches the ARE within a few seconds; the rest of the 60 s run reuses settled intervals
+    rng = np.random.default_rng(2)
+    t = np.concatenate([[0.0], np.cumsum(rng.choice([0.005, 0.01, 0.02], size=4000))])
+    sys_ = ck.StateSpace(A, B, C)
+    u = np.sin(t)[:, None]
+    y = rng.normal(size=(t.size, 1))
+    kb = ck.kalman_bucy(sys_, t, u, y, Q, R, np.eye(2), [1.0, 0.0])
+    ekf = ck.extended_kalman_filter(_ekf_of(sys_), t, u, y, Q, R, np.eye(2), [1.0, 0.0],
+                                    dfdx=lambda x, v: A, dhdx=lambda x, v: C)
+    np.testing.assert_allclose(kb.x, ekf.x, rtol=1e-10, atol=1e-11)
+    np.testing.assert_allclose(kb.P, ekf.P, rtol=1e-10, atol=1e-13)
+    _, P = ck.kalman_gain(A, C, Q, R)
+    np.testing.assert_allclose(kb.P[-1], P, rtol=1e-9)
+
+
+def _pendulum_camera(f):
+    return ck.NonlinearSystem(f, n=2, m=1, h=lambda x, u: np.array([np.sin(x[0])]))
+
+
+def _pendulum_one_state_at_a_time(x, u):
+    # the damped pendulum of models.pendulum(d_theta=0.3), written with floats: no batches
+    theta, omega = float(x[0]), float(x[1])
+    return np.array([omega, -0.3 * omega - 9.81 * math.sin(theta) + float(u[0])])
+
+
+def test_batch_check_accepts_models_and_refuses_what_it_must():
+    from coursekit.kalman import _accepts_batches
+    x0, u0 = np.array([0.4, -1.3]), np.array([0.2])
+    pend = ck.models.pendulum(d_theta=0.3)
+    assert _accepts_batches(pend.f, x0, u0) and _accepts_batches(pend.h, x0, u0)
+    assert _accepts_batches(_pendulum_camera(pend.f).h, x0, u0)
+    assert not _accepts_batches(_pendulum_one_state_at_a_time, x0, u0)           # raises on a batch
+    assert not _accepts_batches(lambda x, u: x - x.mean(), x0, u0)                # mixes the columns
+    assert not _accepts_batches(lambda x, u: np.ravel(x)[:2], x0, u0)            # wrong shape
+
+
+@pytest.mark.parametrize("given_jacobian", [None, "dfdx", "dhdx"])
+def test_ekf_falls_back_to_one_state_at_a_time(given_jacobian):
+    # the same pendulum written for batches (numpy rows) and for one state (floats): the EKF
+    # batches the first and calls the second once per perturbed state; the filters must agree
+    t = np.linspace(0, 5, 501)
+    batch_sys = _pendulum_camera(ck.models.pendulum(d_theta=0.3).f)
+    single_sys = _pendulum_camera(_pendulum_one_state_at_a_time)
+    data = ck.simulate_with_noise(batch_sys, t, None, x0=[1.0, 0.0], Q=np.diag([0, 1e-3]),
+                                  R=[[1e-4]], seed=7)
+    jac = {"dfdx": lambda x, u: np.array([[0, 1], [-9.81 * np.cos(x[0]), -0.3]]),
+           "dhdx": lambda x, u: np.array([[np.cos(x[0]), 0.0]])}
+    kw = {given_jacobian: jac[given_jacobian]} if given_jacobian else {}
+    args = (t, None, data.y, np.diag([1e-4, 1e-2]), [[1e-4]], np.eye(2), [0.3, 1.0])
+    batched = ck.extended_kalman_filter(batch_sys, *args, **kw)
+    single = ck.extended_kalman_filter(single_sys, *args, **kw)
+    np.testing.assert_allclose(batched.x, single.x, rtol=1e-8, atol=1e-9)
+    np.testing.assert_allclose(batched.P, single.P, rtol=1e-8, atol=1e-12)
+    exact = ck.extended_kalman_filter(batch_sys, *args, **jac)
+    np.testing.assert_allclose(batched.x, exact.x, atol=1e-5)        # differences ~ eps^(2/3)
+    assert np.abs(batched.x[-100:, 0] - data.x[-100:, 0]).max() < 0.05
+
+
+@pytest.mark.filterwarnings("ignore:overflow encountered:RuntimeWarning",
+                            "ignore:invalid value encountered:RuntimeWarning")
+def test_filters_report_divergence_and_too_many_steps(monkeypatch):
+    t = np.linspace(0, 1, 11)
+    unseen = ck.StateSpace([[700.0]], [[0.0]], [[0.0]])       # unstable and unobserved: P overflows
+    with pytest.raises(RuntimeError, match=r"the filter diverged at t=0.6 \(non-finite estimate or P\)"):
+        ck.kalman_bucy(unseen, t, None, np.zeros((11, 1)), [[1.0]], [[1.0]], [[1.0]], [1.0])
+    huge_force = ck.StateSpace([[-1.0]], [[1e10]], [[1.0]])     # P stays finite, x̂ overflows
+    with pytest.raises(RuntimeError, match=r"the filter diverged at t=0.1 \(non-finite estimate"):
+        ck.kalman_bucy(huge_force, t, np.full((11, 1), 1e300), np.zeros((11, 1)), [[1.0]], [[1.0]],
+                       [[1.0]], [0.0])
+    blow_up = ck.NonlinearSystem(lambda x, u: x**2, n=1, h=lambda x, u: 0 * x)   # x' = x^2 from 1
+    with pytest.raises(RuntimeError, match=r"the filter diverged at t=1.1"):
+        ck.extended_kalman_filter(blow_up, np.linspace(0, 2, 21), None, np.zeros((21, 1)),
+                                  [[0.0]], [[1.0]], [[1.0]], [1.0])
+    monkeypatch.setattr(ck.kalman, "_MAX_STEPS", 50)
+    fast = {"Q": np.eye(2), "R": [[1e-8]], "P0": 1e3 * np.eye(2), "x0": [0, 0]}   # rate ~ 1e6 at first
+    with pytest.raises(RuntimeError, match=r"needs more than 50 RK4 steps between two samples"):
+        ck.kalman_bucy(ck.StateSpace(A, B, C), t, None, np.zeros((11, 1)), **fast)
+    with pytest.raises(RuntimeError, match=r"needs more than 50 RK4 steps between two samples"):
+        ck.extended_kalman_filter(ck.models.pendulum(), t, None, np.zeros((11, 1)), **fast)

@@ -83,3 +83,32 @@ def test_symbolic_jacobian_3_69_and_3_83():
         ck.symbolic_jacobian(f, [1, 2])
     with pytest.raises(ValueError, match="x_eq has the wrong length"):
         ck.linearize_symbolic(f, [x1, x2], [u], [0], [0])
+
+
+@given(st.integers(1, 5), st.integers(1, 3), st.integers(0, 10_000))
+def test_batched_central_differences_are_the_column_by_column_ones(n, q, seed):
+    # the EKF evaluates g once on the batch of _perturbed(z); _quotients must then give the
+    # numbers _jacobian(refine=False) gets from 2n separate calls, and the last column is z
+    from coursekit.linearization import _jacobian, _perturbed, _quotients
+    rng = np.random.default_rng(seed)
+    z = rng.normal(size=n) * 10 ** rng.uniform(-2, 1.5, size=n)
+    a, i, j = rng.normal(size=q), rng.integers(0, n, size=q), rng.integers(0, n, size=q)
+
+    def g(x):  # polynomial rows: the same arithmetic on one state (n,) or on columns (n, k)
+        return np.array([a[r] * x[i[r]] * x[j[r]] + x[j[r]] ** 3 - 2 * x[i[r]] for r in range(q)])
+
+    Z, h = _perturbed(z)
+    assert Z.shape == (n, 2 * n + 1)
+    np.testing.assert_array_equal(Z[:, -1], z)
+    for k in range(n):
+        plus, minus = z.copy(), z.copy()
+        plus[k], minus[k] = z[k] + h[k], z[k] - h[k]
+        np.testing.assert_array_equal(Z[:, k], plus)
+        np.testing.assert_array_equal(Z[:, n + k], minus)
+    J = _quotients(g(Z), h)
+    np.testing.assert_array_equal(J, _jacobian(g, z, refine=False))
+    exact = np.zeros((q, n))
+    for r in range(q):
+        exact[r, i[r]] += a[r] * z[j[r]] - 2
+        exact[r, j[r]] += a[r] * z[i[r]] + 3 * z[j[r]] ** 2
+    np.testing.assert_allclose(J, exact, rtol=1e-6, atol=1e-8 * max(1.0, np.abs(exact).max()))
