@@ -145,3 +145,14 @@ def test_html_export_with_widget_state_renders_the_image_widget(executed_demo):
     assert len(images) == 1 and images[0]["buffers"][0]["path"] == ["value"]
     assert base64.b64decode(images[0]["buffers"][0]["data"]).startswith(PNG_MAGIC)
     assert "application/vnd.jupyter.widget-view+json" in html and "VBox(" not in html
+
+
+def test_rescale_fits_the_view_to_data_moved_by_an_update():
+    from matplotlib.figure import Figure
+    from coursekit.explorers._base import rescale
+    ax = Figure().subplots()
+    (line,) = ax.plot([0, 1], [0, 1])
+    line.set_data([0, 10], [-5, 50])
+    rescale(ax)
+    lo, hi = ax.get_ylim()
+    assert lo <= -5 and hi >= 50 and ax.get_xlim()[1] >= 10

@@ -27,7 +27,7 @@ import base64
 import io
 from typing import Any, Callable
 
-__all__ = ["Explorer", "slider", "int_slider", "dropdown", "figure_png"]
+__all__ = ["Explorer", "slider", "int_slider", "dropdown", "figure_png", "rescale"]
 
 
 def slider(value: float, min: float, max: float, step: float, description: str, *,
@@ -53,6 +53,13 @@ def dropdown(options, value, description: str):
     import ipywidgets as widgets
     return widgets.Dropdown(options=options, value=value, description=description,
                             style={"description_width": "initial"})
+
+
+def rescale(*axes) -> None:
+    """Fit each axes' view to the data its artists hold now (after ``set_data`` in an update)."""
+    for ax in axes:
+        ax.relim()
+        ax.autoscale_view()
 
 
 def figure_png(fig) -> bytes:

@@ -13,7 +13,7 @@ from .._validation import as_scalar
 from ..realization import euler_discretize
 from ..simulation import simulate
 from ..systems import StateSpace
-from ._base import Explorer, dropdown, slider
+from ._base import Explorer, dropdown, rescale, slider
 
 __all__ = ["EULER_EXAMPLES", "euler_compute", "euler_explorer", "msd_compute", "msd_explorer"]
 
@@ -87,8 +87,7 @@ def euler_explorer() -> Explorer:
         h["ax"].set_ylim(r["x"].min() - 0.5 * span, r["x"].max() + 0.5 * span)
         h["ax"].set_ylabel(f"x1 [{r['unit']}]")
         h["ax_err"].set_ylabel(f"|error| [{r['unit']}]")
-        h["ax_err"].relim()
-        h["ax_err"].autoscale_view()
+        rescale(h["ax_err"])
         verdict = "< 1: stable" if r["stable"] else ">= 1: UNSTABLE"
         h["ax"].set_title(f"{r['example']}, Ts = {r['Ts']:.3g} s, max error {r['max_error']:.2g}\n"
                           f"max|eig(I + Ts A)| = {r['rho']:.3f} {verdict} (stable if Ts < {r['Ts_max']:.3g})")
@@ -150,9 +149,7 @@ def msd_explorer() -> Explorer:
         h["y"].set_data(r["t"], r["y"])
         h["v"].set_data(r["t"], r["v"])
         h["poles"].set_data(r["poles"].real, r["poles"].imag)
-        for ax in (h["ax"], h["ax_p"]):
-            ax.relim()
-            ax.autoscale_view()
+        rescale(h["ax"], h["ax_p"])
         lim = 1.2 * max(1.0, float(np.abs(r["poles"]).max()))
         h["ax_p"].set_xlim(-lim, 0.3 * lim)
         h["ax_p"].set_ylim(-lim, lim)

@@ -13,7 +13,7 @@ from .._validation import as_scalar
 from ..flatness import plan_robot
 from ..simulation import simulate
 from ..trajectory import feedforward, poly_trajectory
-from ._base import Explorer, int_slider, slider
+from ._base import Explorer, int_slider, rescale, slider
 
 __all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robot_planner_explorer"]
 
@@ -77,9 +77,7 @@ def planner_explorer() -> Explorer:
         h["ud"].set_data(r["t"], r["ud"])
         for line in h["marks"]:
             line.set_xdata([r["T"], r["T"]])
-        for ax in (h["ax_y"], h["ax_u"]):
-            ax.relim()
-            ax.autoscale_view()
+        rescale(h["ax_y"], h["ax_u"])
         h["ax_y"].set_title(f"degree {2 * r['r'] - 1} move to {r['target']:g} m in T = {r['T']:g} s, mass error "
                             f"{r['mass_error']:g} %: |y(T) - target| = {r['end_error']:.2g} m")
 

@@ -15,7 +15,7 @@ from ..linearization import linearize
 from ..placement import place
 from ..simulation import simulate, simulate_batch
 from ..systems import StateSpace
-from ._base import Explorer, slider
+from ._base import Explorer, rescale, slider
 
 __all__ = [
     "pair_poles",
@@ -100,9 +100,7 @@ def pole_placement_explorer() -> Explorer:
         for i, line in enumerate(h["xs"]):
             line.set_data(r["t"], r["x"][:, i])
         h["u"].set_data(r["t"], r["u"])
-        for ax in (h["ax_x"], h["ax_u"]):
-            ax.relim()
-            ax.autoscale_view()
+        rescale(h["ax_x"], h["ax_u"])
         h["ax_x"].set_title(f"response from x0 = [1, 0, 0]\n{_gain_text(r['K'])}")
         h["ax_u"].set_title(f"control effort u(t), max |u| = {r['max_u']:.3g}")
 
@@ -186,9 +184,7 @@ def upright_pendulum_explorer() -> Explorer:
         h["fl"].set_data(r["t"], r["dev_fl"])
         h["ulin"].set_data(r["t"], r["u_linear"])
         h["ufl"].set_data(r["t"], r["u_fl"])
-        for ax in (h["ax_th"], h["ax_u"]):
-            ax.relim()
-            ax.autoscale_view()
+        rescale(h["ax_th"], h["ax_u"])
         verdict = lambda ok: "upright" if ok else "NOT upright"  # noqa: E731
         h["ax_th"].set_title(f"start {r['theta0_deg']:g} deg from upright, |u| <= {r['u_max']:g} N m\n"
                              f"linear: {verdict(r['linear_ok'])}, feedback linearizing: {verdict(r['fl_ok'])}")
@@ -254,9 +250,7 @@ def integral_action_explorer() -> Explorer:
         h["off"].set_ydata([r["offset"], r["offset"]])
         h["uplain"].set_data(r["t"], r["u_plain"])
         h["uint"].set_data(r["t"], r["u_int"])
-        for ax in (h["ax_y"], h["ax_u"]):
-            ax.relim()
-            ax.autoscale_view()
+        rescale(h["ax_y"], h["ax_u"])
         h["ax_y"].set_title(f"step disturbance d = {r['d']:g} at t = 1 s; "
                             f"K_E = [{', '.join(f'{k:.3g}' for k in r['K_E'][0])}]")
 

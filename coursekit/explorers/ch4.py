@@ -18,7 +18,7 @@ from ..kalman import kalman_gain, simulate_with_noise, white_noise
 from ..observability import place_observer
 from ..observers import observer_system
 from ..simulation import simulate
-from ._base import Explorer, slider
+from ._base import Explorer, rescale, slider
 
 __all__ = ["KALMAN_TRUE_Q", "KALMAN_TRUE_R", "observer_noise_compute", "observer_noise_explorer", "kalman_tuning_compute",
            "kalman_tuning_explorer"]
@@ -94,8 +94,7 @@ def _set_two_state(h, r):
     h["est_v"].set_data(r["t"], r["x_hat"][:, 1])
     for ax in (h["ax_p"], h["ax_v"]):
         ax.set_xlim(r["t"][0], r["t"][-1])
-    h["ax_p"].relim()
-    h["ax_p"].autoscale_view()
+    rescale(h["ax_p"])
     # velocity axis: the truth with a margin, so a very noisy estimate is clipped, not squashing it
     v = r["x"][:, 1]
     span = max(float(np.ptp(v)), 0.5)
