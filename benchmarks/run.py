@@ -146,19 +146,39 @@ def imports_only(nb, modules=()):
     return baseline
 
 
-_LIST_MODULES = ("import sys as _sys\n"
-                 "print(' '.join(m for m in _sys.modules if not any(p.startswith('_') for p in m.split('.'))))")
+# Prepended to the probe run: sums the time spent rendering figures, i.e. every Agg draw
+# (inline figures and explorers alike) and every PNG encode, without changing what runs.
+_TIME_RENDERING = """\
+import time as _time
+import matplotlib.image as _image
+from matplotlib.backends.backend_agg import FigureCanvasAgg as _Agg
+_rendering = [0.0]
+def _timed(func):
+    def wrapper(*args, **kwargs):
+        start = _time.perf_counter()
+        try:
+            return func(*args, **kwargs)
+        finally:
+            _rendering[0] += _time.perf_counter() - start
+    return wrapper
+_Agg.draw, _image.imsave = _timed(_Agg.draw), _timed(_image.imsave)"""
+
+_REPORT = ("import sys as _sys\n"
+           "print(_rendering[0], *(m for m in _sys.modules if not any(p.startswith('_') for p in m.split('.'))))")
 
 
-def modules_loaded(nb) -> set:
-    """Every public module the notebook has imported by its end, lazily imported ones included
-    (scipy.signal at the first pole placement, matplotlib's PNG writer at the first figure, ...)."""
+def probe(nb) -> tuple[set, float]:
+    """Run the notebook once, instrumented, and return every public module it has imported by
+    its end (lazily imported ones included: scipy.signal at the first pole placement, ...) and
+    the seconds it spent rendering figures (Agg draws and PNG encoding)."""
     import copy
     import nbformat
-    probe = copy.deepcopy(nb)
-    probe.cells.append(nbformat.v4.new_code_cell(_LIST_MODULES))
-    run_notebook(probe, keep=True)
-    return set(probe.cells[-1].outputs[0]["text"].split())
+    probe_nb = copy.deepcopy(nb)
+    probe_nb.cells.insert(0, nbformat.v4.new_code_cell(_TIME_RENDERING))
+    probe_nb.cells.append(nbformat.v4.new_code_cell(_REPORT))
+    run_notebook(probe_nb, keep=True)
+    rendering, *modules = "".join(out.get("text", "") for out in probe_nb.cells[-1].outputs).split()
+    return set(modules), float(rendering)
 
 
 def run_notebook(nb, keep: bool = False) -> None:
@@ -173,19 +193,25 @@ def run_notebook(nb, keep: bool = False) -> None:
 def bench_notebooks(repeat: int) -> list[str]:
     """Each notebook against two floors: its own import lines, and the same import lines plus
     every module the full run ends up importing (the heavy SciPy submodules, sympy and
-    ipywidgets load lazily, inside the coursekit functions that need them)."""
+    ipywidgets load lazily, inside the coursekit functions that need them). The last two
+    columns show how much of the budget matplotlib alone takes: the time one instrumented run
+    spends drawing and encoding its figures, and the ratio a run would reach if that were all it
+    did beyond the second floor (no computation, no cell overhead)."""
     import nbformat
-    rows = ["| notebook | full run | import lines only | ratio | all modules it imports | ratio (target <= 2) |",
-            "|---|---|---|---|---|---|"]
+    rows = ["| notebook | full run | import lines only | ratio | all modules it imports "
+            "| ratio (target <= 2) | figure rendering (one run) | (all modules + rendering) / all modules |",
+            "|---|---|---|---|---|---|---|---|"]
     for path in sorted((ROOT / "notebooks").glob("*.ipynb")):
         nb = nbformat.read(path, as_version=4)
-        lines_only, all_imports = imports_only(nb), imports_only(nb, modules_loaded(nb))
+        modules, rendering = probe(nb)
+        lines_only, all_imports = imports_only(nb), imports_only(nb, modules)
         med = interleaved({"full": lambda: run_notebook(nb),
                            "lines": lambda: run_notebook(lines_only),
                            "modules": lambda: run_notebook(all_imports)}, repeat)
         rows.append(f"| {path.name} | {med['full']:.1f} s | {med['lines']:.1f} s "
                     f"| {med['full'] / med['lines']:.2f} | {med['modules']:.1f} s "
-                    f"| {med['full'] / med['modules']:.2f} |")
+                    f"| {med['full'] / med['modules']:.2f} | {rendering:.1f} s "
+                    f"| {(med['modules'] + rendering) / med['modules']:.2f} |")
     return rows
 
 
