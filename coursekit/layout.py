@@ -9,7 +9,9 @@ labels, so `fit_margins` estimates it without rendering any text and sets
 it with ``subplots_adjust`` each time the figure is drawn. In lecture mode the
 fonts are so large that legends and titles can outgrow their axes, which the
 estimate does not model, so there the figure is measured (constrained layout)
-instead: slower, but right on the projector.
+instead: slower, but right on the projector. Constrained layout cannot handle
+a colorbar that split an axes' grid cell (``fig.colorbar(im, ax=ax)``), so
+such a figure keeps the estimate in lecture mode too.
 """
 
 from __future__ import annotations
@@ -39,7 +41,10 @@ def fit_margins(fig):
     from the tick labels, axis labels, titles and suptitle -- without
     measuring text -- and applies them with ``subplots_adjust``. Call it once
     on any figure whose axes come from ``plt.subplots`` or a GridSpec (calling
-    it again changes nothing); every figure coursekit draws uses it. In
+    it again changes nothing); every figure coursekit draws uses it. Colorbars
+    made with ``fig.colorbar(im, ax=ax)`` or ``cax=`` in a grid cell are laid
+    out with their axes; one made for several axes (``ax=[ax1, ax2]``) moves
+    them by hand, and the figure then keeps matplotlib's margins. In
     lecture mode the figure is laid out by constrained layout instead. A
     layout engine set on the figure (``fig.set_layout_engine``) takes
     precedence. Returns the figure.
@@ -80,7 +85,7 @@ def _make_hook_class():
             fig = self.get_figure()
             if fig is None or fig.get_layout_engine() is not None:
                 return
-            if is_lecture_mode():
+            if is_lecture_mode() and not _splits_a_cell(fig):
                 for ax in fig.axes:
                     ax.title.set_wrap(True)  # a title wider than the figure breaks into lines
                 ConstrainedLayoutEngine().execute(fig)
@@ -93,12 +98,11 @@ def _make_hook_class():
 
 def _apply(fig) -> None:
     """Set the margins and gaps of the figure's axes grid from their estimated needs."""
-    axes = [ax for ax in fig.axes if ax.get_visible() and ax.get_subplotspec() is not None]
-    if not axes:
+    grid = _grid_cells(fig)
+    if grid is None:
         return
-    nrows, ncols = axes[0].get_subplotspec().get_gridspec().get_geometry()
+    (nrows, ncols), spans = grid
     width, height = fig.get_size_inches() * 72.0
-    spans = [(ax.get_subplotspec().rowspan, ax.get_subplotspec().colspan, _axes_needs(ax)) for ax in axes]
 
     def outer(side, at_edge):
         return _EDGE + max([need[side] for rows, cols, need in spans if at_edge(rows, cols)], default=0.0)
@@ -115,6 +119,51 @@ def _apply(fig) -> None:
         return  # the figure is too small for its labels; leave matplotlib's defaults
     fig.subplots_adjust(left=left / width, right=1 - right / width, bottom=bottom / height,
                         top=1 - top / height, wspace=gap_w / axes_w, hspace=gap_h / axes_h)
+
+
+def _splits_a_cell(fig) -> bool:
+    """True if an axes lies in a sub-grid of a grid cell, as after ``fig.colorbar(im, ax=ax)``:
+    constrained layout cannot lay such a figure out afterwards (it divides by zero), so lecture
+    mode keeps the estimate for it."""
+    return any(spec is not None and spec.get_topmost_subplotspec() is not spec
+               for spec in (ax.get_subplotspec() for ax in fig.axes))
+
+
+def _grid_cells(fig):
+    """``((nrows, ncols), [(rowspan, colspan, need), ...])`` for the figure's grid of axes.
+
+    Each axes is placed by the cell of the figure's top-level grid it lies in, so an axes that
+    shares its cell with others (``fig.colorbar(im, ax=ax)`` splits the cell between the axes
+    and the colorbar) only counts the sides where it reaches the cell's edge. None when
+    subplots_adjust would undo a placement: axes from different grids, or an axes moved off
+    its cell (``fig.colorbar(im, ax=[ax1, ax2])`` shrinks its axes by hand).
+    """
+    axes = [ax for ax in fig.axes if ax.get_visible() and ax.get_subplotspec() is not None]
+    if not axes:
+        return None
+    grid = axes[0].get_subplotspec().get_topmost_subplotspec().get_gridspec()
+    spans = []
+    for ax in axes:
+        spec = ax.get_subplotspec()
+        cell = spec.get_topmost_subplotspec()
+        box = spec.get_position(fig)
+        if cell.get_gridspec() is not grid or not _same_box(ax.get_position(original=True), box):
+            return None
+        spans.append((cell.rowspan, cell.colspan, _edge_needs(ax, box, cell.get_position(fig))))
+    return grid.get_geometry(), spans
+
+
+def _same_box(a, b, tol: float = 1e-9) -> bool:
+    return all(abs(p - q) <= tol for p, q in zip(a.bounds, b.bounds))
+
+
+def _edge_needs(ax, box, cell) -> list:
+    """The axes' needs on the sides where its box reaches the edge of its grid cell, 0 elsewhere
+    (inside a shared cell, the gaps belong to the sub-grid that split it)."""
+    tol = 1e-9
+    reaches = (box.x0 <= cell.x0 + tol, box.x1 >= cell.x1 - tol,
+               box.y0 <= cell.y0 + tol, box.y1 >= cell.y1 - tol)
+    return [need if edge else 0.0 for need, edge in zip(_axes_needs(ax), reaches)]
 
 
 def _gap(spans, k: int, across: int) -> float:

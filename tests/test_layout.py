@@ -56,6 +56,45 @@ FIGURES = {"response": _response, "grid": _grid_with_wide_labels, "state plane":
            "explorer": _explorer}
 
 
+_IMAGE = np.random.default_rng(0).normal(size=(20, 20)) * 1000   # tick labels like -3000
+
+
+def _image_pair(title):
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4))
+    for ax in axes:
+        ax.set(title=title, xlabel="x", ylabel="y")
+    return fig, axes, [ax.imshow(_IMAGE) for ax in axes]
+
+
+def _colorbar_per_axes():
+    """fig.colorbar(im, ax=ax) splits each axes' grid cell between the axes and its colorbar."""
+    fig, axes, images = _image_pair("colorbar per axes")
+    for ax, im in zip(axes, images):
+        fig.colorbar(im, ax=ax, label="value [units]")
+    return ck.fit_margins(fig)
+
+
+def _colorbar_below():
+    fig, axes = plt.subplots(2, 1, figsize=(6, 6))
+    for ax in axes:
+        im = ax.pcolormesh(_IMAGE)
+        ax.set(title="colorbar under row 2", ylabel="y")
+    # the gap inside the split cell is the colorbar's own pad (a fraction of the axes' height);
+    # 0.3 leaves room for the second axes' tick labels in lecture mode as well
+    fig.colorbar(im, ax=axes[1], orientation="horizontal", label="value", pad=0.3)
+    return ck.fit_margins(fig)
+
+
+def _colorbar_shared():
+    """fig.colorbar(im, ax=[...]) shrinks its axes by hand, outside any grid."""
+    fig, axes, images = _image_pair("one colorbar for both")
+    fig.colorbar(images[-1], ax=axes, label="value")
+    return ck.fit_margins(fig)
+
+
+COLORBAR_FIGURES = {"colorbar per axes": _colorbar_per_axes, "colorbar below": _colorbar_below}
+
+
 def _drawn_tick_labels(axis, coord):
     """Tick labels inside the view (matplotlib keeps, but does not draw, the others)."""
     lo, hi = sorted(axis.get_view_interval())
@@ -76,11 +115,11 @@ def _text_boxes(fig, renderer):
 
 
 @pytest.mark.parametrize("lecture", [False, True], ids=["default fonts", "lecture mode"])
-@pytest.mark.parametrize("name", FIGURES)
+@pytest.mark.parametrize("name", {**FIGURES, **COLORBAR_FIGURES})
 def test_every_label_fits_inside_the_figure_without_overlapping_another_axes(name, lecture):
     ck.lecture_mode(lecture)
     try:
-        fig = FIGURES[name]()
+        fig = {**FIGURES, **COLORBAR_FIGURES}[name]()
         renderer = _draw(fig)
         width, height = fig.canvas.get_width_height()
         for owner, box in _text_boxes(fig, renderer):
@@ -168,3 +207,37 @@ def test_a_layout_engine_set_on_the_figure_takes_precedence():
     _draw(reference)
     assert np.allclose(ours, [ax.get_position().bounds for ax in reference.axes])
     plt.close("all")
+
+
+def test_a_colorbar_that_splits_a_cell_keeps_the_axes_in_that_cell_and_is_laid_out_with_them():
+    fig = _colorbar_per_axes()
+    renderer = _draw(fig)
+    images, colorbars = fig.axes[:2], fig.axes[2:]          # colorbars are added after the grid
+    for image, colorbar in zip(images, colorbars):
+        cell = image.get_subplotspec().get_topmost_subplotspec().get_position(fig)
+        for ax in (image, colorbar):
+            assert cell.x0 - 1e-9 <= ax.get_position().x0 and ax.get_position().x1 <= cell.x1 + 1e-9
+    # the first colorbar's label ends left of the second axes' tick labels
+    label_end = colorbars[0].yaxis.label.get_window_extent(renderer).x1
+    tick_start = min(t.get_window_extent(renderer).x0 for t in _drawn_tick_labels(images[1].yaxis, 1))
+    assert label_end < tick_start
+    plt.close("all")
+
+
+@pytest.mark.parametrize("lecture", [False, True], ids=["default fonts", "lecture mode"])
+def test_axes_moved_by_hand_keep_their_place(lecture):
+    ck.lecture_mode(lecture)
+    try:
+        fig = _colorbar_shared()
+        images, colorbar = fig.axes[:2], fig.axes[2]
+        _draw(fig)
+        renderer = fig.canvas.get_renderer()
+        bar = colorbar.get_window_extent(renderer)
+        for ax in images:
+            assert not ax.get_window_extent(renderer).overlaps(bar)
+        if not lecture:          # in lecture mode constrained layout places all three
+            placed = [ax.get_position(original=True).bounds for ax in fig.axes]
+            assert placed == [ax.get_position(original=True).bounds for ax in _colorbar_shared().axes]
+    finally:
+        ck.lecture_mode(False)
+        plt.close("all")
