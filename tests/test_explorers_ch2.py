@@ -2,7 +2,11 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
+from scipy.integrate import solve_ivp
+from scipy.special import fresnel
 
+import coursekit as ck
 from coursekit.explorers import ch2
 
 
@@ -46,3 +50,41 @@ def test_explorers_build_and_update(factory):
     first.value = first.min
     assert explorer.params[next(iter(explorer.controls))] == first.min
     assert explorer.result is not before
+
+
+def test_drive_robot_follows_a_circle_and_a_clothoid_exactly():
+    t = np.linspace(0.0, 7.0, 301)
+    v, w = 1.5, 0.8                        # constant speed and turn rate: a circle of radius v / w
+    x = ch2.drive_robot(t, np.column_stack([np.full_like(t, v), np.full_like(t, w)]), np.zeros(3))
+    np.testing.assert_allclose(x, np.column_stack([v / w * np.sin(w * t), v / w * (1 - np.cos(w * t)), w * t]),
+                               atol=1e-12)
+    a = 0.3                                # turn rate 2 a t: theta = a t^2, a clothoid (Fresnel integrals)
+    x = ch2.drive_robot(t, np.column_stack([np.full_like(t, v), 2 * a * t]), np.zeros(3))
+    S, C = fresnel(t * np.sqrt(2 * a / np.pi))
+    scale = v * np.sqrt(np.pi / (2 * a))
+    np.testing.assert_allclose(x, np.column_stack([scale * C, scale * S, a * t**2]), atol=1e-12)
+
+
+def _ode_interval_by_interval(t, u, x0):
+    """(1.10) by an ODE solver restarted at every sample, so that no step straddles a kink of
+    the piecewise-linear input (stepping across kinks, solve_ivp can miss them by 1e-6)."""
+    f = ck.models.two_wheeled_robot().f
+    x = [np.asarray(x0, float)]
+    for k in range(t.size - 1):
+        slope = (u[k + 1] - u[k]) / (t[k + 1] - t[k])
+        sol = solve_ivp(lambda tk, xk: f(xk, u[k] + slope * (tk - t[k])), (t[k], t[k + 1]), x[-1],
+                        method="DOP853", rtol=1e-12, atol=1e-12)
+        x.append(sol.y[:, -1])
+    return np.array(x)
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.integers(10, 80), st.floats(0.5, 10.0), st.integers(0, 10_000))
+def test_drive_robot_agrees_with_an_ode_solver_on_random_sampled_inputs(samples, T, seed):
+    rng = np.random.default_rng(seed)
+    t = np.linspace(0.0, T, samples)
+    u = np.column_stack([1.0 + 0.3 * rng.normal(size=samples).cumsum() / np.sqrt(samples),
+                         rng.normal(size=samples).cumsum() / np.sqrt(samples)])
+    x0 = rng.normal(size=3)
+    ode = _ode_interval_by_interval(t, u, x0)
+    np.testing.assert_allclose(ch2.drive_robot(t, u, x0), ode, atol=1e-10 * max(1.0, np.abs(ode).max()))

@@ -15,7 +15,8 @@ from ..simulation import simulate
 from ..trajectory import feedforward, poly_trajectory
 from ._base import Explorer, int_slider, rescale, slider
 
-__all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robot_planner_explorer"]
+__all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robot_planner_explorer",
+           "drive_robot"]
 
 #: the plant of the trajectory planner: mass-spring-damper (2.27) [kg, N s/m, N/m]
 PLANNER_PLANT = dict(m=1.0, d=0.5, k=2.0)
@@ -117,11 +118,38 @@ def robot_planner_compute(x_T: float = 4.0, y_T: float = 2.0, heading_deg: float
                     min_speed=0.0, target=target, T=T, message=str(err).split(":")[0])
     u = plan.u(t)
     # the input samples, linear in between (as a digital controller replays them), drive the model
-    driven = simulate(models.two_wheeled_robot(), t, u=u, x0=plan.x0, rtol=1e-6, atol=1e-9).x
+    driven = drive_robot(t, u, plan.x0)
     end_error = float(np.hypot(*(driven[-1, :2] - target[:2])))
     return dict(t=t, path=plan.x(t), driven=driven, u=u, end_error=end_error,
                 min_speed=plan.min_speed, target=target, T=T,
                 message=f"end error {end_error:.1e} m, min speed {plan.min_speed:.2f} m/s")
+
+
+def drive_robot(t, u, x0) -> np.ndarray:
+    """Drive the two-wheeled robot (1.10) with inputs linear between the samples; (N, 3) states.
+
+    Exact up to rounding, and a hundred times faster than a general ODE solver,
+    because (1.10) is a cascade: theta' = u2 does not depend on the position,
+    so with u2 linear on each interval theta is quadratic there (found in closed
+    form), and x1' = u1 cos(theta), x2' = u1 sin(theta) are integrals of known
+    smooth functions, taken on each interval by 5-point Gauss-Legendre
+    quadrature (exact for polynomials of degree 9). On the planner's inputs,
+    even where the robot turns by a radian within one interval, this agrees
+    with 16-point quadrature to 1e-13, while ``simulate`` (an adaptive ODE
+    solver, stepping across the input's kinks) stays about 1e-8 away even at
+    ``rtol=1e-13``.
+    """
+    h = np.diff(t)[:, None]
+    nodes, weights = np.polynomial.legendre.leggauss(5)
+    s, w = (nodes + 1.0) / 2.0, weights / 2.0          # on [0, 1]
+    speed, turn = u[:, 0], u[:, 1]
+    theta = x0[2] + np.concatenate([[0.0], np.cumsum(np.diff(t) * (turn[:-1] + turn[1:]) / 2.0)])
+    # on [t_k, t_k + h]: theta = theta_k + h (u2_k s + (u2_k+1 - u2_k) s^2 / 2), u1 = u1_k + (u1_k+1 - u1_k) s
+    theta_s = theta[:-1, None] + h * (turn[:-1, None] * s + np.diff(turn)[:, None] * s**2 / 2.0)
+    speed_s = speed[:-1, None] + np.diff(speed)[:, None] * s
+    steps = h * np.stack([(speed_s * np.cos(theta_s)) @ w, (speed_s * np.sin(theta_s)) @ w], axis=1)
+    position = x0[:2] + np.concatenate([[[0.0, 0.0]], np.cumsum(steps, axis=0)])
+    return np.column_stack([position, theta])
 
 
 def robot_planner_explorer() -> Explorer:
