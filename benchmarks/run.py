@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import importlib
 import inspect
+import itertools
 import statistics
 import subprocess
 import sys
@@ -109,15 +110,33 @@ def explorer_factories():
                 yield f"ch{chapter}.{name}", func
 
 
+def slider_grid(explorer) -> list[dict]:
+    """Every combination of each slider's minimum, middle, maximum and current value, and of
+    every option of a dropdown."""
+    choices = []
+    for widget in explorer.controls.values():
+        if hasattr(widget, "min"):
+            middle = type(widget.value)((widget.min + widget.max) / 2)
+            choices.append(sorted({widget.min, middle, widget.max, widget.value}))
+        else:
+            choices.append([o[1] if isinstance(o, tuple) else o for o in widget.options])
+    return [dict(zip(explorer.controls, combo)) for combo in itertools.product(*choices)]
+
+
 def bench_explorers(repeat: int) -> list[str]:
-    rows = ["| explorer | compute (target < 20 ms) | compute + redraw |", "|---|---|---|"]
+    rows = ["| explorer | compute (target < 20 ms) | compute, slowest setting of the slider grid "
+            "| settings over 20 ms | compute + redraw |", "|---|---|---|---|---|"]
     for label, factory in explorer_factories():
         explorer = factory()
         med = interleaved({
             "compute": lambda: explorer._compute(**explorer.params),
             "refresh": explorer.refresh,
         }, repeat)
-        rows.append(f"| {label} | {ms(med['compute'])} | {ms(med['refresh'])} |")
+        grid = slider_grid(explorer)
+        slowest = [interleaved({"compute": lambda: explorer._compute(**params)}, 3)["compute"]
+                   for params in grid]
+        rows.append(f"| {label} | {ms(med['compute'])} | {ms(max(slowest))} "
+                    f"| {sum(t > 0.020 for t in slowest)} of {len(grid)} | {ms(med['refresh'])} |")
     return rows
 
 
