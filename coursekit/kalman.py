@@ -155,14 +155,9 @@ def _records(t, u, y, m: int):
     return t, u, as_series(y, "y", samples=N)
 
 
-def _riccati_rate(A: np.ndarray, L: np.ndarray, C: np.ndarray) -> float:
-    """How fast (4.88) moves near P: its linearization is dP' = (A - L C) dP + dP (A - L C)^T,
-    whose eigenvalues are sums of two eigenvalues of A - L C."""
-    return _closed_loop_rate(A - L @ C)
-
-
-def _closed_loop_rate(M: np.ndarray) -> float:
-    """`_riccati_rate` from M = A - L C: twice the largest |eigenvalue| of M."""
+def _riccati_rate(M: np.ndarray) -> float:
+    """How fast (4.88) moves near P, from M = A - L C: its linearization is
+    dP' = M dP + dP M^T, whose eigenvalues are sums of two eigenvalues of M."""
     return 2.0 * float(np.abs(np.linalg.eigvals(M)).max())
 
 
@@ -182,20 +177,15 @@ def _radius_bound(M: np.ndarray) -> float:
     return float(np.abs(M).sum(axis=1).max())
 
 
-def _step_length(A: np.ndarray, L: np.ndarray, C: np.ndarray, h_max: float) -> float:
-    """min(h_max, 0.5 / rate) with the rate of `_riccati_rate`."""
-    return _closed_loop_step(A - L @ C, h_max)
-
-
-def _closed_loop_step(M: np.ndarray, h_max: float) -> float:
-    """`_step_length` from M = A - L C, which the filters have at hand.
+def _step_length(M: np.ndarray, h_max: float) -> float:
+    """min(h_max, 0.5 / rate) with the rate of `_riccati_rate`, from M = A - L C.
 
     The eigenvalues are only computed when they can matter: when even an
     upper bound of the rate allows h_max, the rate itself does too, and h_max
     is returned as is.
     """
     if 4.0 * h_max * _radius_bound(M) >= 1.0:
-        return min(h_max, 0.5 / max(_closed_loop_rate(M), 1e-300))
+        return min(h_max, 0.5 / max(_riccati_rate(M), 1e-300))
     return h_max
 
 
@@ -215,7 +205,7 @@ def _next_step(tau: float, dt: float, substeps: int, M: np.ndarray) -> float:
     (4.88) at the current P, M = A - L C); stretched to the end of the
     interval when within 1e-9 dt of it.
     """
-    h = _closed_loop_step(M, min(dt - tau, dt / substeps))
+    h = _step_length(M, min(dt - tau, dt / substeps))
     return dt - tau if dt - tau - h < 1e-9 * dt else h
 
 

@@ -229,8 +229,8 @@ def test_step_length_shortcut_is_the_exact_rule(n, seed, h_max):
     A_, L_, C_ = rng.normal(size=(n, n)) * 10 ** rng.uniform(-1, 2), rng.normal(size=(n, 1)), rng.normal(size=(1, n))
     M = A_ - L_ @ C_
     assert _radius_bound(M) >= np.abs(np.linalg.eigvals(M)).max()
-    exact = min(h_max, 0.5 / max(_riccati_rate(A_, L_, C_), 1e-300))
-    assert _step_length(A_, L_, C_, h_max) == exact
+    exact = min(h_max, 0.5 / max(_riccati_rate(M), 1e-300))
+    assert _step_length(M, h_max) == exact
 
 
 def _ekf_of(sys_, **kw):
