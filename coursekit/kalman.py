@@ -46,7 +46,7 @@ import numpy as np
 from ._validation import as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
 from .linearization import _jacobian, _perturbed, _quotients
 from .observability import _obs_pair
-from .simulation import SimulationResult, lti_step_matrices
+from .simulation import SimulationResult, _agrees_column_by_column, lti_step_matrices
 from .systems import NonlinearSystem, StateSpace
 
 __all__ = [
@@ -443,17 +443,16 @@ def _accepts_batches(fun, x0: np.ndarray, u0: np.ndarray) -> bool:
     """True when fun(X, U), states and inputs as columns, agrees column by column with
     fun(x, u) on single states (within 1e-12), checked on the states of `_perturbed(x0)`.
 
-    Like `simulation._check_batch`, but a function written for one state at a
+    The test of `simulation._check_batch`, but a function written for one state at a
     time (``float(x[0])``, ``if x[0] > 0``, ...) is an answer, not an error.
     """
     X, _ = _perturbed(x0)
-    single = np.column_stack([np.ravel(fun(X[:, j], u0)) for j in range(X.shape[1])])
+    U = u0[:, None].repeat(X.shape[1], axis=1)
     try:
-        batch = np.asarray(fun(X, u0[:, None].repeat(X.shape[1], axis=1)), dtype=float)
+        batch = np.asarray(fun(X, U), dtype=float)
     except Exception:                   # written for one state at a time
         return False
-    return batch.size == single.size and np.allclose(batch.reshape(single.shape), single,
-                                                     rtol=1e-12, atol=1e-12)
+    return _agrees_column_by_column(fun, X, U, batch)
 
 
 def _batched_model(f, h, n: int):

@@ -163,10 +163,17 @@ def _check_batch(sys, t0: float, X: np.ndarray, u_fun) -> None:
         raise ValueError(f"f cannot be evaluated on a batch of states (shape {X.shape}): {err}; "
                          "write f with numpy operations on the rows x[0], x[1], ... "
                          "or use simulate for one initial state at a time.") from err
-    single = np.column_stack([sys.f(X[:, j], U[:, j]) for j in range(X.shape[1])])
-    if F.shape != single.shape or not np.allclose(F, single, rtol=1e-12, atol=1e-12):
+    if not _agrees_column_by_column(sys.f, X, U, F):
         raise ValueError("f gives different results on a batch of states than one state at a time; "
                          "use simulate for one initial state at a time.")
+
+
+def _agrees_column_by_column(fun, X: np.ndarray, U: np.ndarray, batch: np.ndarray) -> bool:
+    """True when `batch`, fun's answer for the states X and inputs U as columns, holds
+    fun(X[:, j], U[:, j]) in column j for every j (within 1e-12)."""
+    single = np.column_stack([np.ravel(fun(X[:, j], U[:, j])) for j in range(X.shape[1])])
+    return batch.size == single.size and np.allclose(batch.reshape(single.shape), single,
+                                                     rtol=1e-12, atol=1e-12)
 
 
 def _input(sys, t: np.ndarray, u, x0: np.ndarray):
