@@ -142,12 +142,15 @@ def drive_robot(t, u, x0) -> np.ndarray:
     h = np.diff(t)[:, None]
     nodes, weights = np.polynomial.legendre.leggauss(5)
     s, w = (nodes + 1.0) / 2.0, weights / 2.0          # on [0, 1]
-    speed, turn = u[:, 0], u[:, 1]
+    turn = u[:, 1]
     theta = x0[2] + np.concatenate([[0.0], np.cumsum(np.diff(t) * (turn[:-1] + turn[1:]) / 2.0)])
-    # on [t_k, t_k + h]: theta = theta_k + h (u2_k s + (u2_k+1 - u2_k) s^2 / 2), u1 = u1_k + (u1_k+1 - u1_k) s
+    # on [t_k, t_k + h]: theta = theta_k + h (u2_k s + (u2_k+1 - u2_k) s^2 / 2), u = u_k + (u_k+1 - u_k) s
     theta_s = theta[:-1, None] + h * (turn[:-1, None] * s + np.diff(turn)[:, None] * s**2 / 2.0)
-    speed_s = speed[:-1, None] + np.diff(speed)[:, None] * s
-    steps = h * np.stack([(speed_s * np.cos(theta_s)) @ w, (speed_s * np.sin(theta_s)) @ w], axis=1)
+    inputs_s = u.T[:, :-1, None] + np.diff(u, axis=0).T[:, :, None] * s    # (2, N-1, nodes)
+    # the model's own rates (1.10) at the nodes; x1', x2' do not depend on the position (0 here)
+    states_s = np.stack([np.zeros_like(theta_s), np.zeros_like(theta_s), theta_s])
+    rates = models.two_wheeled_robot().f(states_s, inputs_s)[:2]
+    steps = h * (rates @ w).T
     position = x0[:2] + np.concatenate([[[0.0, 0.0]], np.cumsum(steps, axis=0)])
     return np.column_stack([position, theta])
 
