@@ -27,7 +27,7 @@ _MODULES = (
     # course tools: figure style and layout
     "style", "layout",
     # course tools: environment check (exercises stay the subpackage coursekit.exercises)
-    "environment_check",
+    "environment_check", "diagnostics",
 )
 
 __all__ = ["models"]

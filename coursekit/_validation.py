@@ -36,9 +36,28 @@ def _describe(value) -> str:
     return f"{type(value).__name__} {value!r}"
 
 
+def _is_complex(value) -> bool:
+    """True for complex numbers or arrays, even when their imaginary parts are zero."""
+    if isinstance(value, (complex, np.complexfloating)):
+        return True
+    if isinstance(value, np.ndarray):
+        return np.iscomplexobj(value)
+    if isinstance(value, (list, tuple)):
+        try:
+            return np.iscomplexobj(np.asarray(value))
+        except (TypeError, ValueError):
+            return False
+    return False
+
+
 def _to_float_array(value, name: str) -> np.ndarray:
     if value is None:
         raise ValueError(f"{name} is missing: received None, expected a number or an array.")
+    if _is_complex(value):
+        raise ValueError(
+            f"{name} must contain real numbers: received {_describe(value)} with complex "
+            "entries; pass the real matrix (complex numbers are only accepted as poles)."
+        )
     try:
         # sympy matrices, nested lists and numbers all pass through np.asarray
         arr = np.asarray(value, dtype=float)
