@@ -8,7 +8,8 @@ therefore reuses the helpers of `controllability` and `placement` instead
 of repeating them.
 
 * `obsv(A, C)` builds Wo = [C; CA; ...; CA^(n-1)] (4.12), (4.15);
-* `is_observable(A, C)` is Kalman's criterion, rank Wo = n, with an SVD;
+* `is_observable(A, C)` is Kalman's criterion, rank Wo = n, decided without
+  units by duality with `is_controllable`;
 * `ocf_transform(A, C)` returns T with z = T x in OCF (4.31)-(4.32);
 * `place_observer(A, C, poles)` returns L with eig(A - L C) = poles.
 """
@@ -20,7 +21,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import as_matrix, as_poles, as_square
-from .controllability import _ctrb, _rank
+from .controllability import (_canonical_transform, _check_tol, _controllability, _ctrb,
+                              _marginal_note, _rank, _Staircase)
 from .placement import _multiplicities, place, poly_from_roots
 
 __all__ = [
@@ -71,30 +73,39 @@ def obsv_singular_values(A, C) -> np.ndarray:
 
 
 def is_observable(A, C, *, tol: float | None = None) -> bool:
-    """Kalman's criterion (4.14)-(4.15): rank Wo = n.
+    """Kalman's criterion (4.14)-(4.15), rank Wo = n, decided without units.
 
-    The rank counts singular values of Wo above `tol` (default: NumPy's
-    ``matrix_rank`` rule), which also works for several outputs, where Wo
-    is not square and the notes' ``det(Wo) != 0`` test does not apply.
+    By duality (Wo is the transpose of the controllability matrix of
+    (A^T, C^T)) this is ``is_controllable(A.T, C.T, tol=tol)``: the same
+    answer in any time unit, state units, output units and coordinates;
+    `controllability` explains the method (balancing + orthogonal staircase)
+    and why ``matrix_rank(obsv(A, C))`` cannot promise this. It also works
+    for several outputs, where Wo is not square and the notes'
+    ``det(Wo) != 0`` test does not apply. `tol` as in `is_controllable`.
     """
     A, C = _obs_pair(A, C)
-    return _rank(_obsv(A, C), tol) == A.shape[0]
+    return _controllability(A.T, C.T, _check_tol(tol)).rank == A.shape[0]
 
 
-def require_observable(A: np.ndarray, C: np.ndarray, *, purpose: str) -> np.ndarray:
-    """Return Wo, or raise NotObservableError explaining what failed and why it matters."""
-    W = _obsv(A, C)
-    r = _rank(W, None)
-    n = A.shape[0]
+def require_observable(A: np.ndarray, C: np.ndarray, *, purpose: str,
+                       tol: float | None = None) -> _Staircase:
+    """Return the staircase of the dual pair (A^T, C^T), or raise NotObservableError.
+
+    The verdict is `is_observable`'s; the message says how many directions
+    leave no trace in y, what to do, and whether the decision was marginal.
+    """
+    v = _controllability(A.T, C.T, _check_tol(tol))
+    n, r = A.shape[0], v.rank
     if r < n:
         raise NotObservableError(
             f"(A, C) is not observable, so {purpose} is impossible: the observability "
-            f"matrix Wo = [C; CA; ...; CA^{n - 1}] (4.15) has rank {r} < n = {n}. "
-            f"{n - r} direction(s) of the state leave no trace in y; measure another "
-            "combination of the states (change C), or check A (e.g. with is_observable "
-            "and obsv_singular_values)."
+            f"matrix Wo = [C; CA; ...; CA^{n - 1}] (4.15) has rank {r} < n = {n} (decided "
+            "without units by an orthogonal staircase of the balanced dual pair (A^T, C^T); "
+            f"see is_observable). {n - r} direction(s) of the state leave no trace in y: "
+            "measure another combination of the states (add a row to C), or check the "
+            "entries of A and C." + _marginal_note(v, "nearly observable")
         )
-    return W
+    return v
 
 
 def _single_output(C: np.ndarray, what: str) -> None:
@@ -114,23 +125,29 @@ def ocf_transform(A, C) -> np.ndarray:
     V_{i+1} = A V_i (4.52). Then ``T A T^{-1}`` has ones on the subdiagonal
     and last column ``-[a_0 ... a_{n-1}]``, and ``C T^{-1} = e_n^T`` (4.31)-(4.32).
 
+    By duality V^T is the CCF transform of (A^T, C^T) (V_1^T Wo^T = e_n^T is
+    (2.65) for that pair), so V is computed by `ccf_transform`'s method:
+    without forming Wo, in unit-free coordinates, and checked, with an
+    `AccuracyWarning` when C V misses e_n^T or T A V misses the OCF by more
+    than rounding explains. Badly scaled but observable systems (a DC motor
+    in SI units) get their transform.
+
     Single output only (C of shape (1, n)). Raises `NotObservableError` when
-    Wo is singular: an unobservable system has no OCF.
+    (A, C) is not observable: an unobservable system has no OCF.
     """
     A, C = _obs_pair(A, C)
     _single_output(C, "the OCF")
-    n = A.shape[0]
-    W = require_observable(A, C, purpose="a transform to the observability canonical form")
-    e_n = np.zeros(n)
-    e_n[-1] = 1.0
-    V = np.empty((n, n))
-    # (4.56): V_1 = Wo^{-1} C~^T with C~^T = e_n, solved without forming Wo^{-1}
-    V[:, 0] = np.linalg.solve(W, e_n)
-    # (4.52): V_{i+1} = A V_i
-    for i in range(1, n):
-        V[:, i] = A @ V[:, i - 1]
+    # duality: V = T^{-1} has columns V_i = (T_dual,i)^T, T_dual the CCF transform of (A^T, C^T)
+    T_dual = _canonical_transform(A.T, C.T, form="observability canonical form (4.31)",
+                                  purpose="a transform to the observability canonical form",
+                                  require=_require_observable_dual)
     # (4.49): T = V^{-1}
-    return np.linalg.inv(V)
+    return np.linalg.inv(T_dual.T)
+
+
+def _require_observable_dual(At: np.ndarray, Ct: np.ndarray, *, purpose: str) -> _Staircase:
+    """`require_observable` called with the dual pair (A^T, C^T)."""
+    return require_observable(At.T, Ct.T, purpose=purpose)
 
 
 @dataclass(repr=False)
