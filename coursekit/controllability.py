@@ -27,7 +27,9 @@ coursekit decides instead with quantities that units do not change
 2. *state units*: the states are scaled by powers of two that balance the
    matrix [[A, B], [0, 0]] (LAPACK's balancing, `scipy.linalg.matrix_balance`),
    which undoes a diagonal change of state units x -> D x up to a factor of
-   about 4 whatever D is; then step 1 is repeated;
+   about 4 whatever D is. States that no other state depends on (a motor's
+   position), which balancing cannot reach, get the unit that makes their
+   row of size 1; then the balancing and step 1 are repeated;
 3. *staircase*: orthogonal transformations (SVDs) bring the pair to the
    controllability staircase form: the first block is the range of B, and
    each further block is the part of A times the previous block that is
@@ -150,28 +152,60 @@ class _Staircase:
         return self.margin < _MARGINAL or self.excess > 1 / _MARGINAL
 
 
-def _unit_free(A: np.ndarray, B: np.ndarray):
-    """Steps 1-2 of the module docstring: remove time, input and state units."""
+def _normalize(A: np.ndarray, B: np.ndarray):
+    """A / |A|_F and each column of B over its norm (a zero column stays zero)."""
+    a = np.linalg.norm(A)
+    a = a if a > 0 else 1.0
+    b = np.linalg.norm(B, axis=0)
+    b[b == 0] = 1.0
+    return A / a, B / b, a, b
+
+
+def _scale_states(A: np.ndarray, B: np.ndarray, s: np.ndarray):
+    """The pair in the states x / s: (S^-1 A S, S^-1 B)."""
+    return A / s[:, None] * s[None, :], B / s[:, None]
+
+
+def _balancing(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """State scaling (powers of two) that balances [[A, B], [0, 0]] (LAPACK gebal)."""
     from scipy.linalg import matrix_balance
 
     n, m = B.shape
-    d, alpha, beta = np.ones(n), 1.0, np.ones(m)
-
-    def normalize(A, B, alpha, beta):
-        a = np.linalg.norm(A)
-        b = np.linalg.norm(B, axis=0)
-        b[b == 0] = 1.0                     # a zero column stays zero
-        a = a if a > 0 else 1.0
-        return A / a, B / b, alpha * a, beta * b
-
-    A, B, alpha, beta = normalize(A, B, alpha, beta)
     M = np.zeros((n + m, n + m))
     M[:n, :n], M[:n, n:] = A, B
-    # M_bal = S^-1 M S with S diagonal (powers of two, so exact)
     _, (s, _) = matrix_balance(M, permute=False, separate=True)
-    s = s[:n]
-    A, B, d = A / s[:, None] * s[None, :], B / s[:, None], s
-    A, B, alpha, beta = normalize(A, B, alpha, beta)
+    return s[:n]
+
+
+def _sink_scaling(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """State scaling (powers of two) for the states no other state depends on.
+
+    Balancing leaves such a state (its column of A is zero off the diagonal,
+    e.g. the position of a motor) in whatever unit it came in, since
+    nothing balances its row. Its unit is free, so it is chosen to make its
+    row (A off the diagonal, and B) of norm about 1, like the rest.
+    """
+    off = A - np.diag(np.diag(A))
+    rows = np.hypot(np.linalg.norm(off, axis=1), np.linalg.norm(B, axis=1))
+    sink = ~off.any(axis=0) & (rows > 0)
+    s = np.ones(A.shape[0])
+    s[sink] = 2.0 ** np.round(np.log2(rows[sink]))
+    return s
+
+
+def _unit_free(A: np.ndarray, B: np.ndarray):
+    """Steps 1-2 of the module docstring: remove time, input and state units.
+
+    Returns (A_s, B_s, d, alpha, beta) with A_s = D^-1 A D / alpha and
+    B_s = D^-1 B / beta, where |A_s|_F = 1 and the columns of B_s have norm 1.
+    """
+    A, B, alpha, beta = _normalize(A, B)
+    d = np.ones(A.shape[0])
+    for scaling in (_balancing, _sink_scaling, _balancing):
+        s = scaling(A, B)
+        A, B = _scale_states(A, B, s)
+        A, B, a, b = _normalize(A, B)
+        d, alpha, beta = d * s, alpha * a, beta * b
     return A, B, d, alpha, beta
 
 
@@ -325,11 +359,12 @@ def _canonical_transform(A: np.ndarray, B: np.ndarray, *, form: str, purpose: st
     ratio, miss = _ccf_deviation(Ts, v)
     if ratio > 1:
         warn_accuracy(
-            f"the transform to the {form} misses its defining equations by {miss:.2g} (relative), "
-            f"{ratio:.2g} times more than rounding explains: the canonical form of this system "
-            "is ill-conditioned (its coefficients span many orders of magnitude). Results "
-            "computed from it (gains, trajectories) may be inaccurate; check them, e.g. with "
-            "the eigenvalues of the closed loop.",
+            f"the transform to the {form} misses its defining equations (T B = e_n and the "
+            f"structure of T A T^-1) by {miss:.2g} (relative), {ratio:.2g} times more than the "
+            "rounding of an ill-conditioned T explains: T is inaccurate, and so may be gains or "
+            "trajectories computed from it. Check them (e.g. the eigenvalues of A + B K), and "
+            "check whether the system is nearly uncontrollable: is_controllable(A, B, tol=1e-8) "
+            "False means its input barely reaches some states.",
             stacklevel=4,
         )
     # back to the user's units: T_i = T_s,i D^-1 alpha^(i-n) / beta (z_i is z_1's (i-1)-th derivative)

@@ -3,7 +3,7 @@
 import control
 import numpy as np
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given, settings, strategies as st
 
 import coursekit as ck
 from conftest import sorted_eig
@@ -161,3 +161,43 @@ def test_repeated_more_than_rank_c():
     C = np.array([[1, 0, 0], [0, 1, 0.0]])
     with pytest.raises(ValueError, match=r"at most rank\(C\) = 2 times"):
         ck.place_observer(A, C, [-2, -2, -2])
+
+
+@pytest.mark.parametrize("units", [dict(), dict(time=1e-3), dict(milli=True)])
+def test_ocf_transform_and_observer_of_the_badly_scaled_dc_motor(units):
+    from si_systems import dc_motor, in_units
+    A, _, C = in_units(dc_motor(), **units)
+    assert ck.is_observable(A, C)
+    T = ck.ocf_transform(A, C)
+    # T has cond ~1e16 here, so T A T^-1 cannot be formed in double precision; check the
+    # defining equations without inverting T: T A = A_ocf T and C = e_n^T T (4.31)-(4.32)
+    # det(sI - A) = s (s^2 + (b/J + R/L) s + (b R + K^2) / (J L)), ascending, in these units
+    J, b, K, R, L = 3.2284e-6, 3.5077e-6, 0.0274, 4.0, 2.75e-6
+    a = np.array([0.0, (b * R + K**2) / (J * L), b / J + R / L]) * units.get("time", 1.0) ** np.array([3, 2, 1])
+    A_ocf = np.eye(3, k=-1)
+    A_ocf[:, -1] = -a
+    # entry by entry against the sizes of the terms: T = V^-1 with cond(V) ~ 1e16 in SI units
+    # carries ~5e-12 relative error in its entries (measured); 1e-10 leaves a margin of 20
+    residual = np.abs(T @ A - A_ocf @ T)
+    np.testing.assert_array_less(residual, 1e-10 * (np.abs(T) @ np.abs(A) + np.abs(A_ocf) @ np.abs(T))
+                                 + 1e-300)
+    np.testing.assert_allclose(T[-1:], C, rtol=1e-14)                 # C V = e_n^T
+    poles = np.array([-1e3, -2e3, -3e3]) * units.get("time", 1.0)
+    L = ck.place_observer(A, C, poles)
+    # moving the 1.45e6 rad/s pole to 3e3 needs gains up to 4e14: the closed-loop poles are
+    # ill-conditioned (SciPy's place_poles misses them by 3%, acker by 6e-7; coursekit ~1e-5)
+    np.testing.assert_allclose(np.sort(np.linalg.eigvals(A - L @ C).real), np.sort(poles), rtol=1e-4)
+
+
+@settings(max_examples=30)
+@given(st.integers(1, 30), st.integers(1, 3), st.integers(0, 2**32 - 1))
+def test_observability_is_controllability_of_the_dual(n, p, seed):
+    # (4.15): Wo(A, C) = Wc(A^T, C^T)^T, so both verdicts agree, also for unobservable pairs
+    rng = np.random.default_rng(seed)
+    A, C = rng.normal(size=(n, n)), rng.normal(size=(p, n))
+    hidden = n > 1 and rng.random() < 0.5
+    if hidden:
+        r = int(rng.integers(1, n))
+        A[:r, r:] = 0.0            # the last n - r states never reach the first r ...
+        C[:, r:] = 0.0             # ... nor are they measured: exactly unobservable
+    assert ck.is_observable(A, C) == ck.is_controllable(A.T, C.T) == (not hidden)
