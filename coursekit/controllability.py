@@ -383,8 +383,9 @@ def _ccf_deviation(Ts: np.ndarray, v: _Staircase) -> tuple[float, float]:
 
 
 def _canonical_transform(A: np.ndarray, B: np.ndarray, *, form: str, purpose: str,
+                         equations: str = "T B = e_n and the structure of T A T^-1",
                          require=None) -> np.ndarray:
-    """T with z = T x in the CCF of (A, B), checked; `form` names it in the warning."""
+    """T with z = T x in the CCF of (A, B), checked; `form` and `equations` name it in the warning."""
     require = require or require_controllable
     v = require(A, B, purpose=purpose)
     n = A.shape[0]
@@ -392,8 +393,8 @@ def _canonical_transform(A: np.ndarray, B: np.ndarray, *, form: str, purpose: st
     ratio, miss = _ccf_deviation(Ts, v)
     if ratio > 1:
         warn_accuracy(
-            f"the transform to the {form} misses its defining equations (T B = e_n and the "
-            f"structure of T A T^-1) by {miss:.2g} (relative), {ratio:.2g} times more than the "
+            f"the transform to the {form} misses its defining equations ({equations}) "
+            f"by {miss:.2g} (relative), {ratio:.2g} times more than the "
             "rounding of an ill-conditioned T explains: T is inaccurate, and so may be gains or "
             "trajectories computed from it. Check them (e.g. the eigenvalues of A + B K), and "
             "check whether the system is nearly uncontrollable: is_controllable(A, B, tol=1e-8) "

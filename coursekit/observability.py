@@ -140,6 +140,7 @@ def ocf_transform(A, C) -> np.ndarray:
     # duality: V = T^{-1} has columns V_i = (T_dual,i)^T, T_dual the CCF transform of (A^T, C^T)
     T_dual = _canonical_transform(A.T, C.T, form="observability canonical form (4.31)",
                                   purpose="a transform to the observability canonical form",
+                                  equations="C T^-1 = e_n^T and the structure of T A T^-1",
                                   require=_require_observable_dual)
     # (4.49): T = V^{-1}
     return np.linalg.inv(T_dual.T)

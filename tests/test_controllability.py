@@ -76,7 +76,8 @@ def test_ccf_transform_of_the_badly_scaled_dc_motor(units):
 
 
 @settings(max_examples=40)
-@given(st.integers(2, 8), st.integers(0, 10_000), st.floats(-4, 4), st.lists(st.floats(-4, 4), min_size=8, max_size=8))
+@given(st.integers(2, 8), st.integers(0, 10_000), st.floats(-4, 4),
+       st.lists(st.floats(-4, 4), min_size=8, max_size=8))
 def test_ccf_transform_follows_a_change_of_units(n, seed, log_a, log_d):
     # time t = a t', states x' = D x: T' = diag(a^(i-1-n)) T D^-1, from T_1' A'^k b' = delta_k,n-1
     rng = np.random.default_rng(seed)
@@ -97,7 +98,8 @@ def test_ccf_transform_warns_when_its_result_misses_the_ccf(monkeypatch):
     import coursekit.controllability as cm
     rows = cm._ccf_rows
     monkeypatch.setattr(cm, "_ccf_rows", lambda v: rows(v) * (1 + 1e-6 * np.eye(len(v.Q))[0][:, None]))
-    with pytest.warns(ck.AccuracyWarning, match=r"misses its defining equations .* by [0-9.]+e-0[67] \(relative\)"):
+    with pytest.warns(ck.AccuracyWarning,
+                      match=r"misses its defining equations .* by [0-9.]+e-0[67] \(relative\)"):
         ck.ccf_transform([[0, 1], [-2, -3]], [[0], [1]])
     with pytest.warns(ck.AccuracyWarning, match=r"observability canonical form \(4.31\) misses"):
         ck.ocf_transform([[0, 1], [-2, -3]], [[1, 0]])

@@ -173,7 +173,8 @@ def test_ocf_transform_and_observer_of_the_badly_scaled_dc_motor(units):
     # defining equations without inverting T: T A = A_ocf T and C = e_n^T T (4.31)-(4.32)
     # det(sI - A) = s (s^2 + (b/J + R/L) s + (b R + K^2) / (J L)), ascending, in these units
     J, b, K, R, L = 3.2284e-6, 3.5077e-6, 0.0274, 4.0, 2.75e-6
-    a = np.array([0.0, (b * R + K**2) / (J * L), b / J + R / L]) * units.get("time", 1.0) ** np.array([3, 2, 1])
+    time = units.get("time", 1.0)
+    a = np.array([0.0, (b * R + K**2) / (J * L), b / J + R / L]) * time ** np.array([3, 2, 1])
     A_ocf = np.eye(3, k=-1)
     A_ocf[:, -1] = -a
     # entry by entry against the sizes of the terms: T = V^-1 with cond(V) ~ 1e16 in SI units
