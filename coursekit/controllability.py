@@ -163,11 +163,19 @@ class _Staircase:
         return self.margin < _MARGINAL or self.excess > 1 / _MARGINAL
 
 
+def _norms(M: np.ndarray, axis: int | None = None):
+    """2-norm of M (Frobenius, axis=None) or of its columns (axis=0), safe from overflow."""
+    m = np.abs(M).max(axis=axis, keepdims=True, initial=0.0)
+    safe = np.where(m > 0, m, 1.0)
+    norms = np.linalg.norm(M / safe, axis=axis, keepdims=True) * m
+    return norms.item() if axis is None else norms.reshape(-1)
+
+
 def _normalize(A: np.ndarray, B: np.ndarray):
     """A / |A|_F and each column of B over its norm (a zero column stays zero)."""
-    a = np.linalg.norm(A)
+    a = _norms(A)
     a = a if a > 0 else 1.0
-    b = np.linalg.norm(B, axis=0)
+    b = _norms(B, axis=0)
     b[b == 0] = 1.0
     return A / a, B / b, a, b
 
