@@ -176,3 +176,16 @@ def test_bad_tol(tol):
         ck.is_controllable(np.eye(2), np.ones((2, 1)), tol=tol)
     with pytest.raises(ValueError, match=r"tol must be a number between 0 and 1"):
         ck.is_observable(np.eye(2), np.ones((1, 2)), tol=tol)
+
+
+@settings(max_examples=40)
+@given(st.sampled_from([s for s in SYSTEMS if s.controllable]), log_scale,
+       st.lists(log_scale, min_size=4, max_size=4))
+def test_ccf_transform_of_si_systems_in_random_units(sys, log_a, log_d):
+    # no AccuracyWarning (pytest makes it an error), and T B = e_n row by row against |T_i| |B|:
+    # the transform is computed in unit-free coordinates, so 1e-12 is rounding with a margin
+    n = sys.A.shape[0]
+    A, B, _ = _rescale(sys.A, sys.B, sys.C, 10**log_a, 10 ** np.array(log_d[:n]))
+    T = ck.ccf_transform(A, B)
+    miss = np.abs(T @ B[:, 0] - np.eye(n)[-1]) / (np.linalg.norm(T, axis=1) * np.linalg.norm(B))
+    assert miss.max() < 1e-12
