@@ -92,9 +92,11 @@ def find_equilibria(f, u_eq=None, guesses=None, *, n=None, dt=None, bounds=(-5.0
     found = []
     for x0 in X0:
         residual = _residual(func, name, dt, f"find_equilibria, searching from the guess {x0.tolist()}")
-        sol = root(lambda x: residual(x, u), x0, method="hybr", tol=1e-12)
-        if np.all(np.isfinite(sol.x)) and _is_zero(residual(sol.x, u), tol, sol.x):
-            found.append(sol.x)
+        # a guess outside the model's domain (a square root of a negative state) fails quietly
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            sol = root(lambda x: residual(x, u), x0, method="hybr", tol=1e-12)
+            if np.all(np.isfinite(sol.x)) and _is_zero(residual(sol.x, u), tol, sol.x):
+                found.append(sol.x)
     return _unique(found, X0.shape[1])
 
 

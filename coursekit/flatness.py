@@ -31,7 +31,7 @@ import numpy as np
 from ._validation import as_matrix, as_scalar, as_vector
 from .controllability import _pair, ccf_transform, charpoly
 from .diagnostics import warn_accuracy
-from .trajectory import _EPS, _PLAN_RTOL, plot_plan, poly_trajectory
+from .trajectory import _PLAN_RTOL, plot_plan, poly_trajectory
 
 __all__ = [
     "FlatSystem",
@@ -169,9 +169,9 @@ def _check_linear_maps(A, B, T, Lam, a) -> None:
     if not worst <= _MAPS_RTOL:
         warn_accuracy(
             f"linear_flatness: the flat maps miss their defining equations (2.77)-(2.79): "
-            f"{name} holds only to {worst:.2g} (relative; rounding explains ~{n * _EPS * np.linalg.cond(T):.1g}, "
-            f"allowed {_MAPS_RTOL:g}). The CCF transform T has condition number "
-            f"{np.linalg.cond(T):.2g}, so x = Lambda [F, ..., F^(n-1)] loses that many digits. "
+            f"{name} holds only to {worst:.2g} (relative; allowed {_MAPS_RTOL:g}). The CCF "
+            f"transform T has condition number {np.linalg.cond(T):.2g}, so x = Lambda [F, ..., "
+            f"F^(n-1)] loses about {np.log10(np.linalg.cond(T)):.0f} of the 16 digits. "
             "Use a model in units that make the entries of A and B of similar size, or fewer states.",
             stacklevel=4,
         )
@@ -400,13 +400,21 @@ def plan_flat_output(flat: FlatSystem, T, start, end) -> FlatPlan:
     return plan
 
 
+def _planned_state(plan: FlatPlan, t: float) -> np.ndarray:
+    """plan.x(t), or NaN where the planned F_d, F_d', ... are not finite (psi_x refuses them)."""
+    try:
+        return plan.x(t)
+    except ValueError:
+        return np.full(plan.flat.n, np.nan)
+
+
 def _check_flat_plan(plan: FlatPlan, caller: str, x0, xT, *, angle: int | None = None) -> None:
     """Warn unless the plan's x(0), x(T) from psi_x meet the requested x0, xT.
 
     `angle` is the index of a state compared modulo 2 pi (a heading); the
     others are compared to _PLAN_RTOL of the largest requested state.
     """
-    got = [plan.x(0.0), plan.x(plan.horizon)]
+    got = [_planned_state(plan, t) for t in (0.0, plan.horizon)]
     diffs = [g - w for g, w in zip(got, (x0, xT))]
     if angle is not None:
         for d in diffs:
