@@ -369,3 +369,21 @@ def test_plot_plan_validates_its_arguments():
         plot_plan(t, np.full((5, 2), np.nan), np.zeros(5), title="plan")
     fig = plot_plan(t, np.zeros((5, 2)), np.zeros(5), title="plan")
     assert len(fig.axes[0].lines) == 2 and len(fig.axes[1].lines) == 1
+
+
+@settings(max_examples=40)
+@given(time_unit=st.floats(-4, 4), state_units=st.lists(st.floats(-4, 4), min_size=2, max_size=2))
+def test_open_loop_plan_follows_changes_of_units(time_unit, state_units):
+    # (2.66) in other units: states x~ = D x and time t~ = t / a give A~ = a D A D^-1, B~ = a D B
+    # (the same input u) and the horizon T / a; the plan must be the same plan in the new units
+    A0, B0 = np.array([[0, 2], [1, -3.0]]), np.array([[1.0], [0]])
+    x0, xT, T = np.array([1.0, -1.0]), np.array([3.0, 1.0]), 3.0
+    a, D = 10.0**time_unit, 10.0 ** np.array(state_units)
+    A, B = a * (D[:, None] * A0 / D[None, :]), a * D[:, None] * B0
+    plan = ck.open_loop_control(A, B, D * x0, D * xT, T / a)   # no AccuracyWarning in any units
+    reference = ck.open_loop_control(A0, B0, x0, xT, T)
+    t = np.linspace(0, T, 31)
+    # each state in its own unit: rounding of the CCF transform (cond ~ 10) and of the scalings
+    np.testing.assert_allclose(plan.x(t / a) / D, reference.x(t), rtol=0, atol=1e-9)
+    np.testing.assert_allclose(plan.ud(t / a), reference.ud(t), rtol=0,
+                               atol=1e-9 * np.abs(reference.ud(t)).max())
