@@ -217,27 +217,30 @@ def _boundary_misses(traj: PolyTrajectory) -> list:
     return misses
 
 
+def _out_of_range(traj: PolyTrajectory) -> bool:
+    """True when a power T^(+-k), k <= 2r - 1, or a nonzero y^(k) T^k is outside the normal range."""
+    tiny = np.finfo(float).tiny
+    scaled = np.concatenate([traj._alpha, traj._beta])
+    data = np.concatenate([traj.start, traj.end])
+    unrepresentable = (data != 0) & ~(np.isfinite(scaled) & (np.abs(scaled) >= tiny))
+    with np.errstate(over="ignore", divide="ignore"):
+        powers = np.concatenate([traj._inv_powers, 1.0 / traj._inv_powers[1:]])
+    return bool(np.any(unrepresentable)) or not np.all(np.isfinite(powers) & (powers >= tiny))
+
+
 def _check_boundaries(traj: PolyTrajectory) -> None:
     """Warn when traj misses one of its boundary conditions (2.34)-(2.37) by more than rounding."""
     misses = _boundary_misses(traj)
     if not misses:
         return
-    k, name, want, got, miss, allowed = max(misses, key=lambda m: m[4] / max(abs(m[2]), 1e-300))
-    scaled = np.concatenate([traj._alpha, traj._beta])
-    data = np.concatenate([traj.start, traj.end])
-    tiny = np.finfo(float).tiny
-    # a nonzero condition whose normalized value y^(k) T^k overflowed or fell below the normal
-    # range, or a power T^(+-k) (k <= 2r - 1) that did
-    unrepresentable = (data != 0) & ~(np.isfinite(scaled) & (np.abs(scaled) >= tiny))
-    with np.errstate(over="ignore", divide="ignore"):
-        powers = np.concatenate([traj._inv_powers, 1.0 / traj._inv_powers[1:]])
-    out_of_range = np.any(unrepresentable) or not np.all(np.isfinite(powers) & (powers >= tiny))
+    k, name, want, got, miss, allowed = max(
+        misses, key=lambda m: m[4] / max(abs(m[2]), 1e-300) if np.isfinite(m[4]) else np.inf)
     reason = (
         f"Double precision cannot hold the conditions in normalized time tau = t / T: "
         f"y^(k) T^k over- or underflows for T = {traj.T:g} and k up to {traj.degree}. "
         "Express time in other units so that T is nearer 1 (ms, minutes, hours), or use "
         "fewer boundary conditions."
-        if out_of_range else
+        if _out_of_range(traj) else
         "Try fewer boundary conditions (a lower r) or a horizon T nearer 1 in the time unit used."
     )
     warn_accuracy(
