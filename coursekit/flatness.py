@@ -117,6 +117,8 @@ def linear_flatness(A, B) -> FlatSystem:
     ``x = Lambda [F, F', ..., F^(n-1)]`` with ``Lambda = T^-1`` (2.77)-(2.78)
     and ``u = a_0 F + ... + a_{n-1} F^(n-1) + F^(n)`` (2.79). Raises
     `NotControllableError` for an uncontrollable pair: no flat output exists.
+    The maps are checked against their defining equations (`_check_linear_maps`);
+    an `AccuracyWarning` says when an ill-conditioned CCF transform breaks them.
     """
     A, B = _pair(A, B)
     n = A.shape[0]
@@ -377,6 +379,11 @@ def plan_flat_output(flat: FlatSystem, T, start, end) -> FlatPlan:
     `poly_trajectory`; the input is ``u_d = psi_u(F_d, ..., F_d^(n))``.
     Choose r so that the state's boundary values are matched (r > order_x)
     and, for an input without jumps at the ends, one more.
+
+    Check: with r > order_x the plan's x(0), x(T) = psi_x(F_d, F_d', ...)
+    (2.88) are compared with psi_x of the requested data; a miss of more than
+    1e-6 of the states' size gives an `AccuracyWarning` (as does a trajectory
+    missing its own boundary conditions, see `poly_trajectory`).
     """
     if not isinstance(flat, FlatSystem):
         raise ValueError(f"flat must be a FlatSystem (e.g. pendulum_flatness()): received "
@@ -448,7 +455,9 @@ def plan_robot(start, end, T, *, speed=1.0, L: float | None = None) -> FlatPlan:
     sign (negative: reversing): at zero speed the heading is undefined (the
     singularity of (2.97)-(2.101)). The smallest planned speed on [0, T] is
     found exactly (roots of d|F'|^2/dt) and stored as ``plan.min_speed``; a
-    ValueError explains a plan whose speed vanishes on the way.
+    ValueError explains a plan whose speed vanishes on the way. The planned
+    poses at 0 and T are checked against `start` and `end` (heading modulo
+    2 pi) and an `AccuracyWarning` says when they miss.
     """
     start = as_vector(start, "start", size=3, why="a pose (x1, x2, theta)")
     end = as_vector(end, "end", size=3, why="a pose (x1, x2, theta)")
