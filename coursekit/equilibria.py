@@ -14,28 +14,44 @@ from __future__ import annotations
 import numpy as np
 
 from ._validation import as_matrix, as_scalar, as_vector
+from .diagnostics import call_user
+from .linearization import _function_name
 from .systems import NonlinearSystem, StateSpace
 
 __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
 
 
 def _field(f, n=None, dt=None):
-    """Return (g(x, u), n, m or None, dt) for a system or a bare function."""
+    """Return (func, name, n, m or None, dt) for a system or a bare function f(x, u)."""
     if isinstance(f, (NonlinearSystem, StateSpace)):
-        return f.f, f.n, f.m, f.dt
+        return f.f, _function_name(getattr(f, "_f", f.f)), f.n, f.m, f.dt
     if not callable(f):
         raise ValueError(
             f"f must be a NonlinearSystem or a function f(x, u) returning dx/dt: received "
             f"{type(f).__name__}."
         )
-    return (lambda x, u: np.asarray(f(x, u), dtype=float)), n, None, dt
+    return f, _function_name(f), n, None, dt
 
 
-def _residual(g, dt):
-    # (3.49): f(x*, u*) = 0;  (3.53): f(x*, u*) - x* = 0 in discrete time
-    if dt is None:
-        return lambda x, u: np.ravel(g(x, u))
-    return lambda x, u: np.ravel(g(x, u)) - x
+def _residual(func, name: str, dt, task: str, *, finite: bool = False):
+    """r(x, u) = f(x, u) (3.49), or f(x, u) - x (3.53) in discrete time.
+
+    f is called through `call_user`: an exception it raises becomes a
+    `UserFunctionError` naming it, the point and the `task`. NaN and inf pass
+    through unless `finite` (a solver may step outside the model's domain;
+    `_is_zero` rejects such points).
+    """
+    def r(x, u):
+        where = f"at x = {x.tolist()}, u = {u.tolist()} ({task})"
+        value = np.ravel(call_user(func, (x, u), name, where=where, finite=finite))
+        return value - x if dt is not None else value
+    return r
+
+
+def _is_zero(r: np.ndarray, tol: float, *sizes: np.ndarray) -> bool:
+    """|r| <= tol max(1, |sizes|), written so that NaN or inf never passes."""
+    scale = max([1.0] + [float(np.abs(v).max(initial=0.0)) for v in sizes])
+    return bool(np.all(np.abs(r) <= tol * scale)) and bool(np.all(np.isfinite(r)))
 
 
 def find_equilibria(f, u_eq=None, guesses=None, *, n=None, dt=None, bounds=(-5.0, 5.0),
@@ -61,19 +77,26 @@ def find_equilibria(f, u_eq=None, guesses=None, *, n=None, dt=None, bounds=(-5.0
     Returns
     -------
     (k, n) array of distinct equilibria (rows), sorted by their entries.
-    Points closer than ``1e-6 * max(1, |x|)`` count as the same equilibrium.
+    Each satisfies |f(x*, u*)| <= tol max(1, |x*|) (|f(x*, u*) - x*| in
+    discrete time); a NaN or inf residual never counts. Points closer than
+    ``1e-6 * max(1, |x|)`` count as the same equilibrium.
+
+    An exception raised by f becomes a `UserFunctionError` (a ValueError)
+    naming the function, the point and the guess the search started from.
     """
-    g, n_sys, m, sys_dt = _field(f, n, dt)
+    func, name, n_sys, m, sys_dt = _field(f, n, dt)
     dt = sys_dt if dt is None else as_scalar(dt, "dt", positive=True)
     u = _input(u_eq, m)
     X0 = _guesses(guesses, n_sys if n_sys is not None else n, bounds, count, seed)
-    residual = _residual(g, dt)
     from scipy.optimize import root
     found = []
     for x0 in X0:
-        sol = root(lambda x: residual(x, u), x0, method="hybr", tol=1e-12)
-        if np.abs(residual(sol.x, u)).max() <= tol * max(1.0, np.abs(sol.x).max()):
-            found.append(sol.x)
+        residual = _residual(func, name, dt, f"find_equilibria, searching from the guess {x0.tolist()}")
+        # a guess outside the model's domain (a square root of a negative state) fails quietly
+        with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+            sol = root(lambda x: residual(x, u), x0, method="hybr", tol=1e-12)
+            if np.all(np.isfinite(sol.x)) and _is_zero(residual(sol.x, u), tol, sol.x):
+                found.append(sol.x)
     return _unique(found, X0.shape[1])
 
 
@@ -117,19 +140,25 @@ def equilibrium_input(f, x_eq, *, m=None, u_guess=None, tol: float = 1e-9) -> np
     Uses least squares (`scipy.optimize.least_squares`) from `u_guess`
     (default zero) and raises ValueError when no input achieves f(x*, u*) = 0,
     i.e. when x* cannot be held by any constant input (for the pendulum
-    (3.55): any x* with x2* != 0). `m` is needed only for a bare function.
+    (3.55): any x* with x2* != 0); a NaN or inf residual never passes. `m` is
+    needed only for a bare function. An exception raised by f, or NaN/inf it
+    returns at the starting input, becomes a `UserFunctionError` (a
+    ValueError) naming the function and the point.
     """
-    g, n, m_sys, dt = _field(f)
+    func, name, n, m_sys, dt = _field(f)
     m = m_sys if m_sys is not None else (None if m is None else int(as_scalar(m, "m", integer=True)))
     if m is None or m < 1:
         raise ValueError("m must be the number of inputs (>= 1): pass m= for a bare function f(x, u).")
     x = as_vector(x_eq, "x_eq", size=n)
     u0 = np.zeros(m) if u_guess is None else as_vector(u_guess, "u_guess", size=m)
-    residual = _residual(g, dt)
+    task = "equilibrium_input, solving f(x_eq, u) = 0 for u"
+    # the starting point must be finite, or the search has nowhere to go
+    _residual(func, name, dt, task + " from u_guess", finite=True)(x, u0)
+    residual = _residual(func, name, dt, task)
     from scipy.optimize import least_squares
     sol = least_squares(lambda u: residual(x, u), u0, xtol=1e-14, ftol=1e-14, gtol=1e-14)
     r = residual(x, sol.x)
-    if np.abs(r).max() > tol * max(1.0, np.abs(x).max(), np.abs(sol.x).max()):
+    if not _is_zero(r, tol, x, sol.x):
         raise ValueError(
             f"x_eq = {x.tolist()} is not an equilibrium for any constant input: the smallest "
             f"residual f(x*, u*) found is {np.array2string(r, precision=3)}. Pick x_eq so "

@@ -30,7 +30,8 @@ import numpy as np
 
 from ._validation import as_matrix, as_scalar, as_vector
 from .controllability import _pair, ccf_transform, charpoly
-from .trajectory import plot_plan, poly_trajectory
+from .diagnostics import warn_accuracy
+from .trajectory import _PLAN_RTOL, plot_plan, poly_trajectory
 
 __all__ = [
     "FlatSystem",
@@ -116,6 +117,8 @@ def linear_flatness(A, B) -> FlatSystem:
     ``x = Lambda [F, F', ..., F^(n-1)]`` with ``Lambda = T^-1`` (2.77)-(2.78)
     and ``u = a_0 F + ... + a_{n-1} F^(n-1) + F^(n)`` (2.79). Raises
     `NotControllableError` for an uncontrollable pair: no flat output exists.
+    The maps are checked against their defining equations (`_check_linear_maps`);
+    an `AccuracyWarning` says when an ill-conditioned CCF transform breaks them.
     """
     A, B = _pair(A, B)
     n = A.shape[0]
@@ -139,7 +142,41 @@ def linear_flatness(A, B) -> FlatSystem:
     flat = FlatSystem(name="linear system", n=n, m=1, order_x=n - 1, order_u=n,
                       phi=phi, psi_x=psi_x, psi_u=psi_u, params=dict(A=A, B=B))
     flat.T1, flat.Lambda, flat.a = T[0].copy(), Lam, a
+    _check_linear_maps(A, B, T, Lam, a)
     return flat
+
+
+# Rounding leaves residuals of about n eps cond(T) in (2.77)-(2.79) (random 16-state systems:
+# cond(T) ~ 1e8, residuals <= 5e-12); above 1e-8 the maps no longer describe the system.
+_MAPS_RTOL = 1e-8
+
+
+def _check_linear_maps(A, B, T, Lam, a) -> None:
+    """Warn unless x = Lambda z, u = a.z + F^(n) satisfy x' = A x + B u and F = T_1 x.
+
+    Along any F(t), z = [F, ..., F^(n-1)] obeys z' = A_c z + e_n u with the CCF
+    matrix A_c (2.16), so x = Lambda z solves x' = A x + B u exactly when
+    A Lambda = Lambda A_c and Lambda e_n = B; F = T_1 x needs T_1 Lambda = e_1^T.
+    """
+    n = A.shape[0]
+    A_c = np.eye(n, k=1)
+    A_c[-1] = -a
+    norm = np.linalg.norm
+    residuals = {
+        "A Lambda = Lambda A_c": norm(A @ Lam - Lam @ A_c) / (norm(Lam) * (norm(A) + norm(A_c))),
+        "Lambda e_n = B": norm(Lam[:, -1] - B[:, 0]) / norm(B),
+        "T_1 Lambda = e_1^T": norm(T[0] @ Lam - np.eye(n)[0]) / (norm(T[0]) * norm(Lam)),
+    }
+    name, worst = max(residuals.items(), key=lambda item: item[1] if np.isfinite(item[1]) else np.inf)
+    if not worst <= _MAPS_RTOL:
+        warn_accuracy(
+            f"linear_flatness: the flat maps miss their defining equations (2.77)-(2.79): "
+            f"{name} holds only to {worst:.2g} (relative; allowed {_MAPS_RTOL:g}). The CCF "
+            f"transform T has condition number {np.linalg.cond(T):.2g}, so x = Lambda [F, ..., "
+            f"F^(n-1)] loses about {np.log10(np.linalg.cond(T)):.0f} of the 16 digits. "
+            "Use a model in units that make the entries of A and B of similar size, or fewer states.",
+            stacklevel=4,
+        )
 
 
 def pendulum_flatness(m: float = 1.0, l: float = 1.0, g: float = 9.81,
@@ -342,6 +379,11 @@ def plan_flat_output(flat: FlatSystem, T, start, end) -> FlatPlan:
     `poly_trajectory`; the input is ``u_d = psi_u(F_d, ..., F_d^(n))``.
     Choose r so that the state's boundary values are matched (r > order_x)
     and, for an input without jumps at the ends, one more.
+
+    Check: with r > order_x the plan's x(0), x(T) = psi_x(F_d, F_d', ...)
+    (2.88) are compared with psi_x of the requested data; a miss of more than
+    1e-6 of the states' size gives an `AccuracyWarning` (as does a trajectory
+    missing its own boundary conditions, see `poly_trajectory`).
     """
     if not isinstance(flat, FlatSystem):
         raise ValueError(f"flat must be a FlatSystem (e.g. pendulum_flatness()): received "
@@ -353,7 +395,53 @@ def plan_flat_output(flat: FlatSystem, T, start, end) -> FlatPlan:
         raise ValueError(f"end must have the shape of start: received {E.shape}, expected {S.shape} "
                          "(the same derivatives at both ends).")
     trajs = [poly_trajectory(T, S[:, j], E[:, j]) for j in range(flat.m)]
-    return FlatPlan(flat, T, trajs)
+    plan = FlatPlan(flat, T, trajs)
+    if S.shape[0] > flat.order_x:
+        # the states the boundary data ask for: psi_x of the requested F, F', ... (2.88)
+        try:
+            wanted = [flat.psi_x(list(S)), flat.psi_x(list(E))]
+        except ValueError:
+            # a singular start or end (a robot at rest): psi_x explains it when x(t) is asked for
+            return plan
+        _check_flat_plan(plan, "plan_flat_output", *wanted)
+    return plan
+
+
+def _planned_state(plan: FlatPlan, t: float) -> np.ndarray:
+    """plan.x(t), or NaN where the planned F_d, F_d', ... are not finite (psi_x refuses them)."""
+    try:
+        return plan.x(t)
+    except ValueError:
+        return np.full(plan.flat.n, np.nan)
+
+
+def _check_flat_plan(plan: FlatPlan, caller: str, x0, xT, *, angle: int | None = None) -> None:
+    """Warn unless the plan's x(0), x(T) from psi_x meet the requested x0, xT.
+
+    `angle` is the index of a state compared modulo 2 pi (a heading); the
+    others are compared to _PLAN_RTOL of the largest requested state.
+    """
+    got = [_planned_state(plan, t) for t in (0.0, plan.horizon)]
+    diffs = [g - w for g, w in zip(got, (x0, xT))]
+    if angle is not None:
+        for d in diffs:
+            d[angle] = np.arctan2(np.sin(d[angle]), np.cos(d[angle]))
+    task = max(1.0 if angle is not None else 0.0, np.abs(x0).max(), np.abs(xT).max())
+    allowed = _PLAN_RTOL * (task if task > 0 else 1.0)
+    misses = [float(np.abs(d).max()) for d in diffs]
+    if all(miss <= allowed for miss in misses):
+        return
+    k = int(np.argmax([m if np.isfinite(m) else np.inf for m in misses]))
+    when, wanted = ("x(0)", x0) if k == 0 else ("x(T)", xT)
+    warn_accuracy(
+        f"{caller}: the plan's {when} = psi_x(F_d, F_d', ...) (2.88) is "
+        f"{np.array2string(got[k], precision=6)} instead of {np.array2string(wanted, precision=6)}, "
+        f"off by {misses[k]:.3g}, more than {_PLAN_RTOL:g} of the requested states' size {task:.3g}. "
+        "The flat output misses its boundary conditions (see the poly_trajectory warning) or "
+        "psi_x amplifies their rounding; try a horizon T nearer 1 in the time unit used or fewer "
+        "boundary conditions.",
+        stacklevel=4,
+    )
 
 
 def plan_robot(start, end, T, *, speed=1.0, L: float | None = None) -> FlatPlan:
@@ -367,7 +455,9 @@ def plan_robot(start, end, T, *, speed=1.0, L: float | None = None) -> FlatPlan:
     sign (negative: reversing): at zero speed the heading is undefined (the
     singularity of (2.97)-(2.101)). The smallest planned speed on [0, T] is
     found exactly (roots of d|F'|^2/dt) and stored as ``plan.min_speed``; a
-    ValueError explains a plan whose speed vanishes on the way.
+    ValueError explains a plan whose speed vanishes on the way. The planned
+    poses at 0 and T are checked against `start` and `end` (heading modulo
+    2 pi) and an `AccuracyWarning` says when they miss.
     """
     start = as_vector(start, "start", size=3, why="a pose (x1, x2, theta)")
     end = as_vector(end, "end", size=3, why="a pose (x1, x2, theta)")
@@ -387,6 +477,7 @@ def plan_robot(start, end, T, *, speed=1.0, L: float | None = None) -> FlatPlan:
     S = [start[:2], v0 * np.array([np.cos(start[2]), np.sin(start[2])])]
     E = [end[:2], vT * np.array([np.cos(end[2]), np.sin(end[2])])]
     plan = plan_flat_output(flat, T, S, E)
+    _check_flat_plan(plan, "plan_robot", start, end, angle=2)
     t_min, plan.min_speed = _slowest_point(plan)
     if plan.min_speed <= 1e-6 * max(abs(v0), abs(vT)):
         raise ValueError(
@@ -404,7 +495,7 @@ def _slowest_point(plan: FlatPlan):
     """(t, |F'(t)|) where the planned speed is smallest on [0, T], from the roots of d|F'|^2/dt."""
     P = np.polynomial.Polynomial
     # F_j as polynomials in the centred time s = 2 t / T - 1; F_j' in s is proportional to F_j' in t
-    vel = [P(traj._derivs[1]) for traj in plan.trajectories]
+    vel = [P(traj.coeffs).deriv() for traj in plan.trajectories]
     speed_sq = sum(v * v for v in vel)
     roots = speed_sq.deriv().roots()
     s = np.concatenate([[-1.0, 1.0], roots.real[(np.abs(roots.imag) < 1e-9) & (np.abs(roots.real) <= 1)]])

@@ -1,8 +1,10 @@
 """Linear approximation of a nonlinear system around an equilibrium (section 3.4.2).
 
 * `linearize(f, x_eq, u_eq)` returns the Jacobians A = df/dx and B = df/du at
-  (x*, u*) (3.80), computed numerically with central differences refined by
-  Richardson extrapolation (error of order h^4, about 1e-10 relative for smooth f);
+  (x*, u*) (3.80), computed numerically: central differences over a ladder of
+  steps, refined by Richardson extrapolation, the most accurate one chosen by
+  its error estimate (Ridders' method), so the accuracy does not depend on
+  where the equilibrium lies (a pendulum that has turned 1000 times);
 * `symbolic_jacobian(f, variables)` is the Jacobian matrix (3.65) of sympy
   expressions, and `linearize_symbolic(f, x, u, x_eq, u_eq)` evaluates it
   at an equilibrium, giving (A, B) as exact sympy matrices.
@@ -19,13 +21,20 @@ from typing import Callable
 import numpy as np
 
 from ._validation import as_scalar, as_vector
+from .diagnostics import call_user, warn_accuracy
 from .systems import NonlinearSystem, StateSpace
 
 __all__ = ["linearize", "symbolic_jacobian", "linearize_symbolic"]
 
 
+def _function_name(func: Callable, role: str = "f") -> str:
+    """How error messages name a user function: its role, and its own name if it has one."""
+    own = getattr(func, "__name__", "")
+    return f"{role} ({own})" if own and own not in (role, "<lambda>") else role
+
+
 def _vector_field(f, x_eq, u_eq):
-    """Return (g, x, u, n, m, dt): g(x, u) -> float array, whatever form f has."""
+    """Return (func, name, x, u, n, m, dt): the user's f(x, u), how to name it, and the checked point."""
     if isinstance(f, (NonlinearSystem, StateSpace)):
         n, m, dt = f.n, f.m, f.dt
         x = as_vector(x_eq, "x_eq", size=n, why=f"one per state of the {n}-state system")
@@ -33,7 +42,7 @@ def _vector_field(f, x_eq, u_eq):
             u_eq, "u_eq", size=m, why=f"one per input of the system with m={m}")
         if m == 0:
             u = np.zeros(0)
-        return f.f, x, u, n, m, dt
+        return f.f, _function_name(getattr(f, "_f", f.f)), x, u, n, m, dt
     if not callable(f):
         raise ValueError(
             f"f must be a NonlinearSystem or a function f(x, u) returning dx/dt: received "
@@ -41,7 +50,7 @@ def _vector_field(f, x_eq, u_eq):
         )
     x = as_vector(x_eq, "x_eq")
     u = np.zeros(0) if u_eq is None else as_vector(u_eq, "u_eq")
-    return (lambda xx, uu: np.asarray(f(xx, uu), dtype=float)), x, u, x.size, u.size, None
+    return f, _function_name(f), x, u, x.size, u.size, None
 
 
 def _central(g: Callable, z: np.ndarray, h: np.ndarray, k: int) -> np.ndarray:
@@ -51,7 +60,8 @@ def _central(g: Callable, z: np.ndarray, h: np.ndarray, k: int) -> np.ndarray:
     return (g(z + step) - g(z - step)) / (2 * h[k])
 
 
-_CBRT_EPS = float(np.cbrt(np.finfo(float).eps))
+_EPS = float(np.finfo(float).eps)
+_CBRT_EPS = float(np.cbrt(_EPS))
 
 
 def _filter_steps(z: np.ndarray) -> np.ndarray:
@@ -88,25 +98,161 @@ def _quotients(G: np.ndarray, h: np.ndarray) -> np.ndarray:
     return (G[:, :n] - G[:, n:2 * n]) / (2 * h)
 
 
+# Ridders' ladder: steps h_j = h_0 / 2^j, j < _LADDER, down to ~1e-9 h_0, at most _TABLEAU
+# Richardson columns (error terms h^2 ... h^12 removed). The absolute ladder starts at
+# h_0 = 1/4 whatever |z_k| is (sin(x) at x = 2 pi 1000 needs steps below ~1); for |z_k| >
+# _RELATIVE a second ladder from |z_k| / 4 is tried too (polynomials and exponentials of
+# large arguments, where a step relative to |z_k| is right) and kept only when it agrees
+# with the first: large steps can fake convergence on oscillating functions (for sin, the
+# quotients at h = 1024, 2048, 4096 differ by factors cos(h) that happen to be near 1).
+_LADDER = 30
+_TABLEAU = 6
+_ABSOLUTE_TOP = 0.25
+_RELATIVE = 16.0
+
+
+def _probe(g: Callable, z: np.ndarray):
+    """g(z) as a flat float array, or None where g raises.
+
+    The large steps of the ladder may leave the function's domain (a square
+    root, a logarithm): such steps are skipped (as are NaN/inf values, in
+    `_quotient_ladder`); `_checked_jacobian` reports the error when no step
+    is usable.
+    """
+    try:
+        return np.ravel(np.asarray(g(z), dtype=float))
+    except Exception:  # the user's function outside its domain: this step is not usable
+        return None
+
+
+def _quotient_ladder(g: Callable, z: np.ndarray, k: int, q: int,
+                     h0: float) -> tuple[np.ndarray, np.ndarray]:
+    """(D, noise): central differences along e_k for the steps h0 / 2^j and their rounding errors.
+
+    D has shape (_LADDER, q), NaN where a step is unusable. noise[j] bounds the
+    rounding in row j: eps (|g(z + h e_k)| + |g(z - h e_k)| + |z_k| |D_j|) / 2h,
+    the values' own rounding and that of an argument of size |z_k| inside g
+    (a model computing x / 1000 or x - 2 pi sees x only to eps |x|).
+    """
+    G = np.full((2, _LADDER, q), np.nan)
+    width = np.ones(_LADDER)
+    with np.errstate(all="ignore"):
+        for j in range(_LADDER):
+            plus, minus = z.copy(), z.copy()
+            plus[k] += h0 / 2**j
+            minus[k] -= h0 / 2**j
+            # the step actually taken: z_k + h is rounded, so use the difference of the arguments
+            width[j] = plus[k] - minus[k]
+            for side, point in enumerate((plus, minus)):
+                value = _probe(g, point)
+                if value is not None and value.size == q:
+                    G[side, j] = value
+        D = (G[0] - G[1]) / width[:, None]
+        noise = _EPS * (np.abs(G[0]) + np.abs(G[1]) + abs(z[k]) * np.abs(D)).max(axis=1) / width
+    unusable = ~np.isfinite(D).all(axis=1)
+    D[unusable], noise[unusable] = np.nan, np.nan
+    return D, noise
+
+
+def _ridders_column(D: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, float]:
+    """(column, error estimate) from the ladder D by Richardson extrapolation (Ridders).
+
+    Row j, column c of the tableau removes the h^2, ..., h^(2c) error terms:
+    R[j, c] = R[j, c-1] + (R[j, c-1] - R[j-1, c-1]) / (4^c - 1). Its error is
+    estimated by its distance to the two entries it came from, and at least
+    twice the rounding of its newest row (the extrapolation weights add up
+    to less than 2); the entry with the smallest estimate is returned.
+    """
+    best, best_err = D[0], np.inf
+    previous = D
+    for c in range(1, _TABLEAU + 1):
+        current = previous[1:] + (previous[1:] - previous[:-1]) / (4.0**c - 1)
+        err = np.maximum(np.abs(current - previous[1:]).max(axis=1),
+                         np.abs(current - previous[:-1]).max(axis=1))
+        err = np.maximum(err, 2 * noise[c:])
+        if np.any(np.isfinite(err)):
+            j = int(np.nanargmin(err))
+            if err[j] < best_err:
+                best, best_err = current[j], float(err[j])
+        previous = current
+    return best, best_err
+
+
+def _column(g: Callable, z: np.ndarray, k: int, q: int) -> tuple[np.ndarray, float]:
+    """(dg/dz_k, error estimate) from the absolute ladder, or the relative one where it agrees."""
+    J, err = _ridders_column(*_quotient_ladder(g, z, k, q, _ABSOLUTE_TOP))
+    if abs(z[k]) > _RELATIVE:
+        h0 = 2.0 ** np.round(np.log2(abs(z[k]))) / 4
+        J_rel, err_rel = _ridders_column(*_quotient_ladder(g, z, k, q, h0))
+        if err_rel < err and np.abs(J_rel - J).max() <= err + err_rel:
+            return J_rel, err_rel
+    return J, err
+
+
+def _ridders(g: Callable, z: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
+    """(J, err): the Jacobian (q, n) of g at z by Ridders' method and each column's error estimate."""
+    J = np.full((q, z.size), np.nan)
+    err = np.full(z.size, np.inf)
+    for k in range(z.size):
+        J[:, k], err[k] = _column(g, z, k, q)
+    return J, err
+
+
 def _jacobian(g: Callable, z: np.ndarray, *, refine: bool = True) -> np.ndarray:
     """Numerical Jacobian of g at z by central differences.
 
-    ``refine=True`` adds Richardson extrapolation (about 1e-10 relative, for
-    `linearize`); ``refine=False`` is one central difference with step
-    ~ eps^(1/3) (about 1e-8 relative, half the evaluations: for filters that
-    need a Jacobian at every step).
+    ``refine=True`` is Ridders' method (`_ridders`, for `linearize`: about
+    1e-10 relative wherever z lies); ``refine=False`` is one central
+    difference with step ~ eps^(1/3) max(1, |z_k|) (about 1e-8 relative near
+    the origin, 2n evaluations: for filters that need a Jacobian at every step).
     """
     if not refine:
         h = _filter_steps(z)
         return np.column_stack([np.ravel(_central(g, z, h, k)) for k in range(z.size)])
-    J = np.empty((np.ravel(g(z)).size, z.size))
-    # step ~ eps^(1/5) balances the h^4 truncation and the rounding error
-    h = 1e-3 * np.maximum(1.0, np.abs(z))
+    return _ridders(g, z, np.ravel(g(z)).size)[0]
+
+
+# A column whose error estimate exceeds 1e-7 of its size is reported: Ridders' method
+# reaches ~1e-10 on smooth functions, so a larger estimate means f is not smooth at the
+# point (a kink, a discontinuity, noise) or its scale is outside the ladder.
+_JACOBIAN_RTOL = 1e-7
+
+
+def _checked_jacobian(g: Callable, z: np.ndarray, q: int, *, symbol: str, variable: str,
+                      name: str, checked: Callable) -> np.ndarray:
+    """Ridders' Jacobian of g at z; raises on NaN, warns when a column is not accurate.
+
+    `checked(z, where)` evaluates the same function through `call_user`: for a
+    column without any usable step it re-raises what f did there, with context.
+    """
+    J, err = _ridders(g, z, q)
     for k in range(z.size):
-        D1 = _central(g, z, h, k)
-        D2 = _central(g, z, h / 2, k)
-        # Richardson: the h^2 error terms cancel in (4 D(h/2) - D(h)) / 3
-        J[:, k] = np.ravel((4 * D2 - D1) / 3)
+        if not np.all(np.isfinite(J[:, k])):
+            step = z.copy()
+            step[k] += _ABSOLUTE_TOP / 2 ** (_LADDER - 1)
+            checked(step, f"at {variable}_eq + {step[k] - z[k]:.2g} e_{k + 1} (a difference-quotient step)")
+            raise ValueError(
+                f"{name} has no derivative with respect to {variable}{k + 1} at the equilibrium: "
+                f"every difference quotient for column {k + 1} of {symbol} is NaN or inf. Check "
+                "that f is defined and smooth in a neighbourhood of x_eq, u_eq (no square root "
+                "or logarithm at the edge of its domain, no division by zero)."
+            )
+    # a (nearly) zero column is measured against the largest entry of the whole matrix
+    floor = np.sqrt(_EPS) * np.abs(J).max(initial=0.0)
+    size = np.maximum(np.abs(J).max(axis=0, initial=0.0), floor)
+    bad = [k for k in range(z.size) if not err[k] <= _JACOBIAN_RTOL * size[k]]
+    if bad:
+        k = max(bad, key=lambda i: err[i] / max(size[i], 1e-300))
+        warn_accuracy(
+            f"linearize: column {k + 1} of {symbol} (d f / d {variable}{k + 1}) is uncertain: its "
+            f"error estimate {err[k]:.2g} exceeds {_JACOBIAN_RTOL:g} of the column's size "
+            f"{size[k]:.3g} ({len(bad)} column(s) affected). Either {name} is not smooth at this "
+            "point (a jump, a switch, noise in its values), or |" + f"{variable}{k + 1}| = "
+            f"{abs(z[k]):.3g} is so large that f sees it only to about {_EPS * abs(z[k]):.1g} "
+            "(rounding). Check f there, shift the coordinates so that the equilibrium is near "
+            "0, or compute the Jacobian exactly with linearize_symbolic.",
+            stacklevel=4,
+        )
     return J
 
 
@@ -128,37 +274,58 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     check_equilibrium : bool
         If True (default), raise ValueError unless f(x*, u*) = 0 (continuous
         time) or f(x*, u*) = x* (discrete time, 3.53) to within `tol`
-        relative: the linear model (3.79) needs an equilibrium.
+        relative to max(1, |x*|, |u*|): the linear model (3.79) needs an
+        equilibrium. A NaN or inf residual never passes.
 
     Returns
     -------
     A : (n, n) array  -- df/dx at (x*, u*)
     B : (n, m) array  -- df/du at (x*, u*) (m = 0 columns without input)
 
-    The derivatives are central differences refined by Richardson
-    extrapolation, accurate to about 1e-10 relative for smooth f.
+    Accuracy: each column is the central difference (f(x + h e_k) - f(x -
+    h e_k)) / 2h over a ladder of 30 steps halving from h = 1/4 (and, for
+    |x_k| > 16, a second ladder from |x_k| / 4, used where it agrees),
+    extrapolated (Richardson, up to h^12) and chosen by its error estimate
+    (Ridders' method). The step does not grow with |x*|: for smooth f the
+    result is accurate to about 1e-10 relative to each column's size,
+    wherever x* lies (the pendulum at 1000 turns as at 0), and for
+    polynomials and exponentials of large arguments as well. A column whose
+    error estimate exceeds 1e-7 of its size gives an `AccuracyWarning` saying
+    which one; a column that is NaN at every step raises ValueError. Steps at
+    which f raises or returns NaN (outside its domain) are skipped.
+
+    Errors raised by f itself, and NaN/inf it returns at (x*, u*), become a
+    `UserFunctionError` (a ValueError) naming the function and the point.
     """
-    g, x, u, n, m, sys_dt = _vector_field(f, x_eq, u_eq)
+    func, name, x, u, n, m, sys_dt = _vector_field(f, x_eq, u_eq)
     dt = sys_dt if dt is None else as_scalar(dt, "dt", positive=True)
-    f0 = np.ravel(g(x, u))
+
+    def checked(xx, uu, where):
+        return np.ravel(call_user(func, (xx, uu), name, where=where))
+
+    f0 = checked(x, u, f"at x_eq = {x.tolist()}, u_eq = {u.tolist()}")
     if f0.size != n:
-        raise ValueError(f"f returned {f0.size} numbers at x_eq; expected {n} (one per state).")
+        raise ValueError(f"{name} returned {f0.size} numbers at x_eq; expected {n} (one per state).")
     if check_equilibrium:
-        _check_equilibrium(f0, x, u, dt, tol)
+        _check_equilibrium(f0, x, u, dt, tol, name)
     # (3.80): A = df/dx (x*, u*),  B = df/du (x*, u*)
-    A = _jacobian(lambda z: g(z, u), x)
-    B = _jacobian(lambda w: g(x, w), u) if m else np.zeros((n, 0))
+    A = _checked_jacobian(lambda z: func(z, u), x, n, symbol="A", variable="x", name=name,
+                          checked=lambda z, where: checked(z, u, where))
+    B = (_checked_jacobian(lambda w: func(x, w), u, n, symbol="B", variable="u", name=name,
+                           checked=lambda w, where: checked(x, w, where))
+         if m else np.zeros((n, 0)))
     return A, B
 
 
-def _check_equilibrium(f0, x, u, dt, tol) -> None:
+def _check_equilibrium(f0, x, u, dt, tol, name: str = "f") -> None:
     # (3.49) in continuous time, (3.53) in discrete time
     residual = f0 - x if dt is not None else f0
     scale = max(1.0, float(np.abs(x).max(initial=0)), float(np.abs(u).max(initial=0)))
-    if np.abs(residual).max(initial=0) > tol * scale:
+    # written so that a NaN residual fails: NaN <= anything is False
+    if not np.all(np.abs(residual) <= tol * scale):
         rule = "f(x*, u*) = x* (3.53)" if dt is not None else "f(x*, u*) = 0 (3.49)"
         raise ValueError(
-            f"x_eq, u_eq is not an equilibrium: {rule} fails with residual "
+            f"x_eq, u_eq is not an equilibrium of {name}: {rule} fails with residual "
             f"{np.array2string(residual, precision=3)}. Find u* with equilibrium_input(f, x_eq) "
             "or x* with find_equilibria, or pass check_equilibrium=False to linearize "
             "around a point that is not an equilibrium."

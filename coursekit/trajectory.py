@@ -2,23 +2,30 @@
 
 * `poly_trajectory(T, start, end)` is the polynomial of degree 2r - 1 that
   meets r boundary values (value and r - 1 derivatives) at t = 0 and t = T,
-  the construction (2.31)-(2.38) for any r;
+  the construction (2.31)-(2.38) for any r, in closed form (a two-point
+  Hermite basis in tau = t / T): accurate to rounding for r up to 20, and it
+  re-checks its boundary conditions;
 * `feedforward(a, b, traj)` is the input (2.25) that makes the output of a
   plant in controllability canonical form follow `traj`;
 * `open_loop_control(A, B, x0, xT, T)` is the algorithm (2.73) for any
   controllable single-input system: transform to the CCF, plan z1 from
-  z0 = T x0 to zT = T xT, and apply the feedforward input.
+  z0 = T x0 to zT = T xT, and apply the feedforward input; the plan is
+  checked by solving the plant exactly with it (`AccuracyWarning` if it
+  does not land).
 """
 
 from __future__ import annotations
 
-from math import factorial, isfinite
+from fractions import Fraction
+from functools import cache
+from math import comb, factorial, isfinite
 from typing import Callable
 
 import numpy as np
 
-from ._validation import as_scalar, as_vector
+from ._validation import as_scalar, as_series, as_vector
 from .controllability import _pair, ccf_transform, charpoly
+from .diagnostics import warn_accuracy
 
 __all__ = ["PolyTrajectory", "poly_trajectory", "feedforward", "OpenLoopPlan", "open_loop_control",
            "plot_plan"]
@@ -36,33 +43,122 @@ def _derivative_order(k) -> int:
     return int(k_float)
 
 
+# Taylor expansions of the normalized polynomial p(tau) are kept at the centres tau = q / 16
+# (q = 0..16); each time is evaluated with the nearest one, |tau - q/16| <= 1/32. Against an
+# exact rational evaluation this keeps every derivative of degree-39 polynomials (r = 20)
+# within ~50 eps of its largest value on [0, T]; with 8 centres r = 20 loses ~1e3 eps, with
+# one expansion at each end ~1e8 eps (the sums then cancel as in a monomial basis).
+_CENTRES = 16
+# A boundary condition comes out of ~6 roundings (the data times T^k, one basis coefficient,
+# a factorial, the division by T^k): a miss above 32 eps of its value is not rounding.
+_BOUNDARY_ULPS = 32.0
+_EPS = float(np.finfo(float).eps)
+
+
+def _taylor_shift(coeffs: list, q: int) -> list:
+    """Integer coefficients of P(q + g) from those of P(g) (ascending), exactly."""
+    a = list(coeffs)
+    for i in range(len(a) - 1):
+        for j in range(len(a) - 2, i - 1, -1):
+            a[j] += q * a[j + 1]
+    return a
+
+
+@cache
+def _hermite_basis(r: int) -> np.ndarray:
+    """Taylor coefficients of the two-point Hermite basis of degree N = 2r - 1 at the centres.
+
+    ``H_k(tau) = tau^k / k! (1 - tau)^r sum_{j < r - k} C(r - 1 + j, j) tau^j``
+    (k = 0..r-1) has ``H_k^(i)(0) = delta_ik`` and ``H_k^(i)(1) = 0`` for i < r:
+    the polynomial with k-th derivative 1 at tau = 0 and every other boundary
+    condition of (2.34)-(2.37) zero. Entry ``[q, k, j]`` is the coefficient of
+    h^j in ``H_k(q / M + h)``, M = `_CENTRES`, computed in exact integer
+    arithmetic and rounded once, so the coefficients that must vanish (those
+    of h^j, j < r, other than j = k at q = 0, and all of them at q = M) are
+    exactly zero.
+    """
+    N, M = 2 * r - 1, _CENTRES
+    out = np.zeros((M + 1, r, N + 1))
+    for k in range(r):
+        # numerator of H_k in powers of tau: tau^k (1 - tau)^r Q_k(tau), integer coefficients
+        numer = [0] * (N + 1)
+        for i in range(r + 1):
+            for j in range(r - k):
+                numer[k + i + j] += (-1) ** i * comb(r, i) * comb(r - 1 + j, j)
+        for q in range(M + 1):
+            # H_k(q/M + h) = sum_j numer_j (q + g)^j / (k! M^j) with g = M h
+            shifted = _taylor_shift([c * M ** (N - j) for j, c in enumerate(numer)], q)
+            den = factorial(k) * M ** N
+            out[q, k] = [float(Fraction(c * M ** j, den)) for j, c in enumerate(shifted)]
+    out.flags.writeable = False
+    return out
+
+
+@cache
+def _falling(N: int) -> np.ndarray:
+    """F[i, l] = (i + l)! / l!: the factor of h^l in the i-th derivative of h^(i + l)."""
+    F = np.zeros((N + 1, N + 1))
+    for i in range(N + 1):
+        for l in range(N + 1 - i):
+            F[i, l] = float(factorial(i + l) // factorial(l))
+    F.flags.writeable = False
+    return F
+
+
 class PolyTrajectory:
     """A polynomial y_d(t) of degree 2r - 1 with given values and derivatives at 0 and T.
 
     Call it as ``traj(t, k=0)`` for the k-th time derivative at time(s) `t`
-    (a number gives a number, an array an array of the same length). The
-    polynomial is stored in the centred, normalized time s = 2 t / T - 1
-    (s = -1 at t = 0, s = 1 at t = T), where its coefficients are of order
-    one whatever T is; a derivative in t is the derivative in s times
-    (2 / T)^k. Outside [0, T] the polynomial is simply continued.
+    (a number gives a number, an array an array of the same length); outside
+    [0, T] the polynomial is simply continued. Attributes: ``T``, ``start``,
+    ``end``, ``r``, ``degree`` and ``coeffs``, the ascending coefficients of
+    the same polynomial in the centred time s = 2 t / T - 1.
+
+    Representation: in the normalized time tau = t / T the polynomial is
+    ``p(tau) = sum_k T^k [y^(k)(0) H_k(tau) + y^(k)(T) G_k(tau)]`` with the
+    two-point Hermite basis H_k of `_hermite_basis` and ``G_k(tau) =
+    (-1)^k H_k(1 - tau)``, and ``y^(k)(t) = p^(k)(t / T) / T^k``. The basis is
+    computed exactly and kept as Taylor expansions at 17 centres in [0, 1];
+    a time is evaluated with the nearest one by Horner's rule. So every
+    derivative is accurate to about 50 eps of its largest value on [0, T]
+    for r up to 20, and at t = 0 and t = T the expansions reproduce the
+    boundary values to a few units in the last place.
     """
 
-    def __init__(self, T: float, start: np.ndarray, end: np.ndarray, coeffs: np.ndarray):
+    def __init__(self, T: float, start: np.ndarray, end: np.ndarray):
         self.T = T
         self.start = start
         self.end = end
         self.r = start.size
-        # coefficients of p(s) = sum_j c_j s^j (ascending) and of its derivatives
-        self.coeffs = coeffs
-        self._derivs = [coeffs]
-        for _ in range(2 * self.r - 1):
-            self._derivs.append(np.polynomial.polynomial.polyder(self._derivs[-1]))
-        self._derivs = [[float(c) for c in d] for d in self._derivs]
+        N = self.degree
+        with np.errstate(over="ignore", under="ignore", invalid="ignore"):
+            Tk = T ** np.arange(self.r, dtype=float)
+            # the boundary conditions in normalized time: d^k p / d tau^k = T^k d^k y / dt^k
+            self._alpha, self._beta = start * Tk, end * Tk
+            H = _hermite_basis(self.r)
+            sign_k = (-1.0) ** np.arange(self.r)
+            sign_j = (-1.0) ** np.arange(N + 1)
+            # G_k(q/M + h) = (-1)^k H_k((M - q)/M - h): the expansion at the mirrored centre
+            C = (np.einsum("k,qkj->qj", self._alpha, H)
+                 + np.einsum("k,qkj->qj", self._beta * sign_k, H[::-1]) * sign_j)
+            # table[q, i, l]: coefficient of h^l in p^(i)(q/M + h)
+            rows = np.arange(N + 1)[:, None] + np.arange(N + 1)[None, :]
+            self._table = np.where(rows <= N, C[:, np.minimum(rows, N)], 0.0) * _falling(N)
+            self._inv_powers = T ** -np.arange(N + 1, dtype=float)
+        # plain-float copies of the table, one centre at a time, for `_scalar_derivatives`
+        self._rows = [None] * (_CENTRES + 1)
+        self._inv = self._inv_powers.tolist()
 
     @property
     def degree(self) -> int:
         """Degree 2r - 1 of the polynomial."""
         return 2 * self.r - 1
+
+    @property
+    def coeffs(self) -> np.ndarray:
+        """Ascending coefficients of the polynomial in the centred time s = 2 t / T - 1."""
+        # tau = 1/2 + s/2: the coefficient of s^j is that of h^j at the middle centre over 2^j
+        return self._table[_CENTRES // 2, 0] / 2.0 ** np.arange(self.degree + 1)
 
     def __call__(self, t, k=0):
         if isinstance(t, float) and isfinite(t) and type(k) is int and k >= 0:
@@ -74,42 +170,90 @@ class PolyTrajectory:
 
     def _scalar_derivatives(self, t: float, order: int) -> list:
         """[y, y', ..., y^(order)] at one time t, in plain floats (fast path for ODE solvers)."""
-        s = 2.0 * t / self.T - 1.0
+        tau = t / self.T
+        q = min(max(round(tau * _CENTRES), 0), _CENTRES)
+        h = tau - q / _CENTRES
+        if self._rows[q] is None:
+            self._rows[q] = self._table[q].tolist()
+        table, N = self._rows[q], self.degree
         out = []
         for k in range(order + 1):
+            if k > N:
+                out.append(0.0)
+                continue
             value = 0.0
-            if k < len(self._derivs):
-                # Horner's rule for p^(k)(s)
-                for c in self._derivs[k][::-1]:
-                    value = value * s + c
-            out.append(value * (2.0 / self.T) ** k)
+            # Horner's rule for p^(k)(q/M + h), then d^k y/dt^k = p^(k) / T^k
+            for c in reversed(table[k][:N + 1 - k]):
+                value = value * h + c
+            out.append(value * self._inv[k])
         return out
 
     def _eval(self, tt, k: int):
         """k-th derivative at the checked times `tt` (no input validation: for inner loops)."""
-        if k >= len(self._derivs):
+        N = self.degree
+        if k > N:
             return np.zeros_like(tt)
-        s = 2.0 * tt / self.T - 1.0
-        # d^k y/dt^k = (2/T)^k d^k p/ds^k
-        return np.polynomial.polynomial.polyval(s, np.array(self._derivs[k])) * (2.0 / self.T) ** k
+        tau = tt / self.T
+        q = np.clip(np.rint(tau * _CENTRES), 0, _CENTRES).astype(int)
+        h = tau - q / _CENTRES
+        coef = self._table[q, k]
+        value = np.zeros_like(tau)
+        # Horner's rule, each time with the expansion at its own centre
+        for l in range(N - k, -1, -1):
+            value = value * h + coef[:, l]
+        return value * self._inv_powers[k]
 
     def __repr__(self) -> str:
         return (f"PolyTrajectory of degree {self.degree} on [0, {self.T:g}]: "
                 f"start {self.start.tolist()}, end {self.end.tolist()}")
 
 
-def _hermite_coefficients(r: int, start_s: np.ndarray, end_s: np.ndarray) -> np.ndarray:
-    """Coefficients of the degree 2r-1 polynomial p(s) meeting s-derivatives at s = -1 and s = 1."""
-    size = 2 * r
-    M = np.zeros((size, size))
-    for k in range(r):
-        for j in range(k, size):
-            # d^k/ds^k s^j = j!/(j-k)! s^(j-k), at s = -1 and at s = 1
-            falling = factorial(j) / factorial(j - k)
-            M[k, j] = falling * (-1.0) ** (j - k)
-            M[r + k, j] = falling
-    # (2.34)-(2.37) in matrix form: M c = [start; end]; (2.38) solves it
-    return np.linalg.solve(M, np.concatenate([start_s, end_s]))
+def _boundary_misses(traj: PolyTrajectory) -> list:
+    """[(k, end name, wanted, got, miss, allowed)] for every boundary condition missed."""
+    misses = []
+    for name, t_end, wanted in (("t = 0", 0.0, traj.start), ("t = T", traj.T, traj.end)):
+        for k, want in enumerate(wanted):
+            got = traj(t_end, k)
+            miss = abs(got - want)
+            allowed = _BOUNDARY_ULPS * _EPS * abs(want)
+            if not miss <= allowed:
+                misses.append((k, name, float(want), got, miss, allowed))
+    return misses
+
+
+def _out_of_range(traj: PolyTrajectory) -> bool:
+    """True when a power T^(+-k), k <= 2r - 1, or a nonzero y^(k) T^k is outside the normal range."""
+    tiny = np.finfo(float).tiny
+    scaled = np.concatenate([traj._alpha, traj._beta])
+    data = np.concatenate([traj.start, traj.end])
+    unrepresentable = (data != 0) & ~(np.isfinite(scaled) & (np.abs(scaled) >= tiny))
+    with np.errstate(over="ignore", divide="ignore"):
+        powers = np.concatenate([traj._inv_powers, 1.0 / traj._inv_powers[1:]])
+    return bool(np.any(unrepresentable)) or not np.all(np.isfinite(powers) & (powers >= tiny))
+
+
+def _check_boundaries(traj: PolyTrajectory) -> None:
+    """Warn when traj misses one of its boundary conditions (2.34)-(2.37) by more than rounding."""
+    misses = _boundary_misses(traj)
+    if not misses:
+        return
+    k, name, want, got, miss, allowed = max(
+        misses, key=lambda m: m[4] / max(abs(m[2]), 1e-300) if np.isfinite(m[4]) else np.inf)
+    reason = (
+        f"Double precision cannot hold the conditions in normalized time tau = t / T: "
+        f"y^(k) T^k over- or underflows for T = {traj.T:g} and k up to {traj.degree}. "
+        "Express time in other units so that T is nearer 1 (ms, minutes, hours), or use "
+        "fewer boundary conditions."
+        if _out_of_range(traj) else
+        "Try fewer boundary conditions (a lower r) or a horizon T nearer 1 in the time unit used."
+    )
+    warn_accuracy(
+        f"poly_trajectory misses {len(misses)} of its {2 * traj.r} boundary conditions "
+        f"(2.34)-(2.37); worst: y^({k}) at {name} is {got:.6g} instead of {want:.6g}, off by "
+        f"{miss:.3g}, while rounding explains at most {allowed:.3g} ({_BOUNDARY_ULPS:g} eps "
+        f"of the value). {reason}",
+        stacklevel=4,
+    )
 
 
 def poly_trajectory(T, start, end) -> PolyTrajectory:
@@ -120,22 +264,28 @@ def poly_trajectory(T, start, end) -> PolyTrajectory:
     the unique polynomial of degree 2r - 1 (r = 2 is the cubic (2.33)).
 
     Returns a `PolyTrajectory` ``traj`` with ``traj(t, k=0)`` the k-th
-    derivative. The linear system (2.37) is set up in the centred normalized
-    time s = 2 t / T - 1, where the k-th derivative is scaled by (T / 2)^k,
-    so it is the same well-conditioned system for T = 0.01 and T = 1000
-    (the monomials t^j of (2.37) would make it hopeless for large r or T).
+    derivative. Instead of solving (2.37) in powers of t (hopeless for long
+    horizons or many conditions: the matrix holds T, T^2, ..., T^(2r-1)),
+    the polynomial is written in closed form in the normalized time
+    tau = t / T with a two-point Hermite basis (see `PolyTrajectory`).
+
+    Guarantees, for r up to 20 and any T whose powers T^k (k < 2r) stay in
+    double range: each boundary value and derivative is met to a few units in
+    the last place of its own value, and every derivative on [0, T] is within
+    about 50 eps of that derivative's largest value there. After building,
+    the 2r boundary conditions are evaluated; a miss of more than
+    32 eps of the value (possible only when y^(k) T^k over- or underflows)
+    gives an `AccuracyWarning` saying which derivative, at which end, by how much.
     """
     T = as_scalar(T, "T", positive=True)
     start = as_vector(start, "start")
     end = as_vector(end, "end", size=start.size,
                     why="the same number of boundary conditions at t = 0 and t = T")
-    r = start.size
-    if r == 0:
+    if start.size == 0:
         raise ValueError("start is empty: expected at least the value y(0) (and its derivatives).")
-    # d^k y/dt^k = (2/T)^k d^k p/ds^k, so the s-derivatives are (T/2)^k times the t-derivatives
-    scale = (T / 2.0) ** np.arange(r)
-    coeffs = _hermite_coefficients(r, start * scale, end * scale)
-    return PolyTrajectory(T, start, end, coeffs)
+    traj = PolyTrajectory(T, start, end)
+    _check_boundaries(traj)
+    return traj
 
 
 def _check_trajectory(traj) -> None:
@@ -193,6 +343,8 @@ class OpenLoopPlan:
     Methods ``ud(t)``, ``z(t)``, ``x(t)`` evaluate the planned input and
     states; ``input(t, x)`` is ``ud`` in the form `simulate` accepts. Times
     outside [0, T] are clipped: before 0 and after T the end values are held.
+    `open_loop_control` has checked that x(0), x(T) and the plant driven by
+    ``ud`` meet x0 and xT (or warned).
     """
 
     def __init__(self, A, B, x0, xT, horizon, transform, a, yd):
@@ -235,12 +387,23 @@ class OpenLoopPlan:
     def input(self, t, x=None) -> np.ndarray:
         """``u(t, x)`` for `simulate`: the open-loop input ignores x (t is clipped to [0, T])."""
         tt = min(max(float(t), 0.0), self.horizon)
-        # the same u_d as ud(t), (2.25) with b = 1, without re-checking t at every solver step
-        y = self.yd._scalar_derivatives(tt, self.n)
-        total = y[self.n]
-        for i in range(self.n):
-            total = total + self.a[i] * y[i]
-        return np.array([total])
+        return np.array(self._input_derivatives(tt, 1))
+
+    def _input_derivatives(self, t: float, count: int) -> list:
+        """[u_d, u_d', ..., u_d^(count-1)] at one time t, in plain floats.
+
+        The same u_d as `ud`, (2.25) with b = 1, differentiated term by term:
+        u_d^(k) = y_d^(n+k) + a_0 y_d^(k) + ... + a_{n-1} y_d^(n-1+k).
+        """
+        n = self.n
+        y = self.yd._scalar_derivatives(t, n + count - 1)
+        out = []
+        for k in range(count):
+            total = y[n + k]
+            for i in range(n):
+                total = total + self.a[i] * y[i + k]
+            out.append(float(total))
+        return out
 
     def plot(self, samples: int = 301):
         """Figure of the planned states x(t) and the input u_d(t) on [0, T]; returns the figure."""
@@ -254,7 +417,16 @@ class OpenLoopPlan:
 
 
 def plot_plan(t, x, u, *, title: str):
-    """Two panels: planned states and planned inputs against time (used by the plan objects)."""
+    """Two panels: planned states and planned inputs against time (used by the plan objects).
+
+    `t` is the (N,) time grid, `x` the (N, n) states and `u` the (N, m) inputs
+    (time-major; a 1-D `u` is one input). Raises ValueError naming the
+    argument whose shape does not fit.
+    """
+    t = as_vector(t, "t")
+    x = as_series(x, "x", samples=t.size)
+    u = as_series(u, "u", samples=t.size)
+    title = str(title)
     from .style import new_figure
     fig, (ax_x, ax_u) = new_figure(1, 2, figsize=(10, 3.6))
     for i in range(x.shape[1]):
@@ -270,6 +442,65 @@ def plot_plan(t, x, u, *, title: str):
     return fig
 
 
+# A plan counts as landing when its own x(0), x(T) and the simulated x(T) are within 1e-6 of
+# the task's size max(|x0|, |xT|). Rounding moves them by ~1e-15 of the largest state on the
+# way, so this holds while the plan stays within ~1e8 times the task's size (the notes'
+# examples: < 10; random 8-state systems with T = 1: ~1e6); 12 random states pass 1e10.
+_PLAN_RTOL = 1e-6
+
+
+def _landing(plan: OpenLoopPlan) -> np.ndarray:
+    """x(T) of x' = A x + B u_d from x0, exactly: (2.4) over 16 steps of the polynomial u_d.
+
+    On each step [t_k, t_k + h] the input is the polynomial u_d with Taylor data
+    w = [u_d, T u_d', ..., T^N u_d^(N)] at t_k, and w' = S w / T (S the shift):
+    one matrix exponential of [[A h, B e_1^T h], [0, S h / T]] gives the exact step.
+    """
+    from scipy.linalg import expm
+    A, B, T, n, N = plan.A, plan.B, plan.horizon, plan.n, plan.yd.degree
+    h = T / _CENTRES
+    M = np.zeros((n + N + 1, n + N + 1))
+    M[:n, :n] = A * h
+    M[:n, n] = B[:, 0] * h
+    M[n:, n:] = np.eye(N + 1, k=1) * (h / T)
+    E = expm(M)
+    scale = T ** np.arange(N + 1, dtype=float)
+    x = plan.x0
+    for k in range(_CENTRES):
+        w = np.array(plan._input_derivatives(k * h, N + 1)) * scale
+        x = E[:n, :n] @ x + E[:n, n:] @ w
+    return x
+
+
+def _check_plan(plan: OpenLoopPlan) -> None:
+    """Warn unless the plan's own x(0), x(T) and the plant driven by u_d meet x0 and xT."""
+    t = np.linspace(0.0, plan.horizon, _CENTRES + 1)
+    with np.errstate(all="ignore"):
+        x_plan = plan.x(t)
+        landed = _landing(plan)
+    task = max(np.abs(plan.x0).max(), np.abs(plan.xT).max())
+    peak = float(np.abs(x_plan).max()) if np.all(np.isfinite(x_plan)) else np.inf
+    misses = {"the planned x(0)": np.abs(x_plan[0] - plan.x0).max(),
+              "the planned x(T)": np.abs(x_plan[-1] - plan.xT).max(),
+              "the simulated x(T)": np.abs(landed - plan.xT).max()}
+    allowed = _PLAN_RTOL * (task if task > 0 else 1.0)
+    worst = max(misses, key=lambda key: misses[key] if np.isfinite(misses[key]) else np.inf)
+    if all(miss <= allowed for miss in misses.values()):
+        return
+    other = "; ".join(f"{key} misses by {miss:.3g}" for key, miss in misses.items() if key != worst)
+    warn_accuracy(
+        f"open_loop_control: the plan does not land. {worst} misses its target by "
+        f"{misses[worst]:.3g}, more than {_PLAN_RTOL:g} of the task's size {task:.3g} ({other}; "
+        f"simulated: x' = A x + B u_d solved exactly). On the way the planned state reaches "
+        f"{peak:.3g} and the CCF transform z = T x (2.65) has condition number "
+        f"{np.linalg.cond(plan.transform):.2g}, so rounding alone moves x(T) this much. "
+        "Try a different horizon T (a longer one if the plan swings far, a shorter one if A "
+        "has fast unstable modes), fewer states (a reduced model), or a model in units that "
+        "make the entries of A and B of similar size.",
+        stacklevel=4,
+    )
+
+
 def open_loop_control(A, B, x0, xT, T, *, smooth: int = 0) -> OpenLoopPlan:
     """Open-loop steering of x' = A x + B u from x0 to xT in time T (algorithm (2.73)).
 
@@ -278,7 +509,16 @@ def open_loop_control(A, B, x0, xT, T, *, smooth: int = 0) -> OpenLoopPlan:
     2. translate the task: z0 = T x0, zT = T xT;
     3. plan y_d = z1 as the polynomial of degree 2n - 1 with
        y_d^(k)(0) = z0[k], y_d^(k)(T) = zT[k] (2.31)-(2.38);
-    4. apply the feedforward u_d (2.25) with the CCF's a and b = 1.
+    4. apply the feedforward u_d (2.25) with the CCF's a and b = 1;
+    5. check the plan: its own x(0) = T^-1 z(0) and x(T), and the end state of
+       the plant driven by u_d (x' = A x + B u_d solved exactly, see
+       `_landing`), must meet x0 and xT to 1e-6 of max(|x0|, |xT|); otherwise
+       an `AccuracyWarning` says which one misses, by how much, how far the
+       plan swings on the way and what to try. The trajectory itself meets
+       its boundary conditions to rounding (`poly_trajectory`), so a miss comes
+       from the plant: a plan whose states pass through values ~1e9 times the
+       task's size (high n, a badly scaled model) cannot land in double
+       precision.
 
     ``smooth = s > 0`` adds s more boundary conditions, y_d^(n)..y_d^(n+s-1)
     = 0 at both ends (degree 2(n + s) - 1): then u_d starts and ends at the
@@ -300,4 +540,6 @@ def open_loop_control(A, B, x0, xT, T, *, smooth: int = 0) -> OpenLoopPlan:
     zeros = np.zeros(int(extra))
     # z0 = T x0, zT = T xT; in the CCF z = [z1, z1', ..., z1^(n-1)]
     yd = poly_trajectory(horizon, np.concatenate([Tz @ x0, zeros]), np.concatenate([Tz @ xT, zeros]))
-    return OpenLoopPlan(A, B, x0, xT, horizon, Tz, a, yd)
+    plan = OpenLoopPlan(A, B, x0, xT, horizon, Tz, a, yd)
+    _check_plan(plan)
+    return plan

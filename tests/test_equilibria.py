@@ -65,3 +65,32 @@ def test_symbolic_pendulum_3_52_and_3_59():
     assert ck.symbolic_equilibria([x1**2], [x1], discrete=True) == [{x1: 0}, {x1: 1}]
     with pytest.raises(ValueError, match="unknowns must be a non-empty list"):
         ck.symbolic_equilibria([x1], [])
+
+
+def test_exceptions_of_f_are_wrapped_with_the_function_name():
+    # issue 14: find_equilibria and equilibrium_input let the user's exception through bare
+    def broken_model(x, u):
+        raise KeyError("mass")
+
+    with pytest.raises(ck.UserFunctionError, match=r"f \(broken_model\) raised KeyError at x = "
+                                                   r"\[0.5, 0.0\].*find_equilibria, searching from"):
+        ck.find_equilibria(broken_model, [0.0], [[0.5, 0.0]])
+    with pytest.raises(ck.UserFunctionError, match=r"broken_model\) raised KeyError .*equilibrium_input"):
+        ck.equilibrium_input(ck.NonlinearSystem(broken_model, n=2, m=1), [0.5, 0.0])
+
+
+def test_nan_residuals_never_make_an_equilibrium():
+    def nan_torque(x, u):  # NaN whatever the input
+        return np.array([x[1], np.nan * (1 + u[0])])
+
+    # the old comparison `residual > tol` was False for NaN and accepted it
+    with pytest.raises(ck.UserFunctionError, match=r"f \(nan_torque\) returned NaN or inf at x = "
+                                                   r"\[0.3, 0.0\], u = \[0.0\]"):
+        ck.equilibrium_input(nan_torque, [0.3, 0.0], m=1)
+    assert ck.find_equilibria(nan_torque, [0.0], [[0.3, 0.0], [1.0, 0.0]]).shape == (0, 2)
+
+
+def test_a_model_undefined_at_some_guesses_still_finds_the_others():
+    # sqrt is NaN for x < 0: the guess -2 fails quietly, the guess 3 finds x* = 4 (sqrt(x) = 2)
+    X = ck.find_equilibria(lambda x, u: np.sqrt(x) - 2.0, None, [[-2.0], [3.0]])
+    np.testing.assert_allclose(X, [[4.0]], atol=1e-9)

@@ -1,8 +1,10 @@
 """Flat outputs and the maps psi_x, psi_u (section 2.4)."""
 
+import re
+
 import numpy as np
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given, settings, strategies as st
 
 import coursekit as ck
 
@@ -139,3 +141,50 @@ def test_flatness_bad_input():
         ck.plan_robot([0, 0], [1, 1, 0], 1.0)
     with pytest.raises(ValueError, match=r"L must be positive"):
         ck.car_like_flatness(L=0)
+
+
+# ---- the planners check their boundary states (issue 14) ----------------------------------
+
+def test_linear_flatness_warns_when_its_maps_miss_2_77_to_2_79():
+    # A = diag(1..10), B = ones: controllable, but the CCF transform has cond ~ 3e11, so
+    # Lambda e_n = B holds only to ~1e-7 (rounding of a 1e11-conditioned inverse)
+    with pytest.warns(ck.AccuracyWarning, match=r"linear_flatness: the flat maps miss .*"
+                                                r"Lambda e_n = B holds only to .* condition number"):
+        ck.linear_flatness(np.diag(np.arange(1.0, 11.0)), np.ones((10, 1)))
+
+
+@settings(max_examples=20)
+@given(n=st.integers(1, 6), seed=st.integers(0, 10_000), logT=st.floats(-2, 2))
+def test_linear_flat_plan_meets_the_requested_states(n, seed, logT):
+    rng = np.random.default_rng(seed)
+    A, B = rng.normal(size=(n, n)), rng.normal(size=(n, 1))
+    if np.linalg.cond(ck.ctrb(A, B)) > 1e6:
+        return
+    flat = ck.linear_flatness(A, B)   # no AccuracyWarning: cond(T) is moderate here
+    T = 10.0**logT
+    start, end = rng.normal(size=n + 1), rng.normal(size=n + 1)
+    plan = ck.plan_flat_output(flat, T, start, end)   # no AccuracyWarning either
+    # psi_x of the planned F_d at the ends is psi_x of the requested data (2.78): the trajectory
+    # meets its conditions to a few ulps, Lambda adds its rounding (cond(T) eps)
+    for when, data in ((0.0, start), (T, end)):
+        want = flat.psi_x(list(data[:n]))
+        np.testing.assert_allclose(plan.x(when), want, rtol=0, atol=1e-9 * max(1.0, np.abs(want).max()))
+
+
+def test_flat_plans_with_an_unrepresentable_horizon_warn():
+    flat = ck.pendulum_flatness()
+    # T^2 = 1e400 overflows: the planned F_d is NaN, and so are the plan's end states psi_x
+    with pytest.warns(ck.AccuracyWarning) as record:
+        ck.plan_flat_output(flat, 1e200, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0])
+    messages = [str(w.message) for w in record]
+    assert any(m.startswith("poly_trajectory misses") for m in messages)
+    assert any(re.match(r"plan_flat_output: the plan.s x\((0|T)\) = psi_x", m) for m in messages)
+
+
+def test_robot_plan_meets_the_requested_poses():
+    # headings compared modulo 2 pi: theta_T = 3 pi / 2 + 2 pi is the same pose as -pi/2
+    start, end = [1.0, -2.0, 0.3], [6.0, 1.0, 3 * np.pi / 2 + 2 * np.pi]
+    plan = ck.plan_robot(start, end, 7.0, speed=0.7)   # no AccuracyWarning
+    np.testing.assert_allclose(plan.x(0.0), start, atol=1e-12)
+    np.testing.assert_allclose(plan.x(7.0)[:2], end[:2], atol=1e-12)
+    assert np.cos(plan.x(7.0)[2] - end[2]) == pytest.approx(1.0, abs=1e-12)

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 import sympy as sp
-from hypothesis import given, strategies as st
+from hypothesis import given, settings, strategies as st
 
 import coursekit as ck
 
@@ -116,3 +116,105 @@ def test_batched_central_differences_are_the_column_by_column_ones(n, q, seed):
         exact[r, i[r]] += a[r] * z[j[r]] - 2
         exact[r, j[r]] += a[r] * z[i[r]] + 3 * z[j[r]] ** 2
     np.testing.assert_allclose(J, exact, rtol=1e-6, atol=1e-8 * max(1.0, np.abs(exact).max()))
+
+
+# ---- accuracy far from the origin, checks and wrapped errors (issue 14) ---------------------
+
+@pytest.mark.parametrize("turns", [0, 100, 1000])
+def test_pendulum_after_many_turns_matches_the_closed_form(turns):
+    # issue 14: with a step growing with |x_eq| the pendulum at 100 turns got A off by 3e-4 and
+    # at 1000 turns completely wrong; (3.67) at theta* = 2 pi turns + pi/4 with u* = m g l sin(theta*)
+    m, l, d = 1.3, 0.7, 0.2
+    P = ck.models.pendulum(m=m, l=l, g=G, d_theta=d)
+    theta = 2 * np.pi * turns + np.pi / 4
+    A, B = ck.linearize(P, [theta, 0.0], [m * G * l * np.sin(theta)])
+    A_true = [[0, 1], [-G / l * np.cos(theta), -d / m]]
+    # documented: ~1e-10 relative to each column, wherever x* lies; 1e-9 leaves a margin of 10
+    np.testing.assert_allclose(A, A_true, rtol=1e-9, atol=1e-9 * G / l)
+    np.testing.assert_allclose(B, [[0], [1 / (m * l**2)]], rtol=1e-9)
+
+
+@pytest.mark.parametrize("fun, dfun, x", [
+    (np.sin, np.cos, 2 * np.pi * 1000),                # curvature scale 1 at a large argument
+    (np.exp, np.exp, 100.0),                           # exponential of a large argument
+    (lambda x: x**10, lambda x: 10 * x**9, 1e6),      # polynomial: a step relative to |x| is right
+    (lambda x: np.exp(x / 1000), lambda x: np.exp(x / 1000) / 1000, 1e5),
+    (lambda x: np.sin(1e4 * x), lambda x: 1e4 * np.cos(1e4 * x), 0.3),   # tiny curvature scale
+    (np.log, lambda x: 1 / x, 1e-6),                   # the large steps leave the domain
+])
+def test_derivatives_of_functions_with_every_scale(fun, dfun, x):
+    A, _ = ck.linearize(lambda z, u: fun(z), [x], check_equilibrium=False)
+    # documented accuracy ~1e-10 relative; 1e-9 leaves a margin
+    np.testing.assert_allclose(A, [[dfun(x)]], rtol=1e-9)
+
+
+@settings(max_examples=30)
+@given(n=st.integers(1, 4), seed=st.integers(0, 10_000), time_unit=st.floats(-4, 4),
+       state_units=st.lists(st.floats(-4, 4), min_size=4, max_size=4),
+       offset=st.floats(0, 4))
+def test_linearization_follows_changes_of_units_and_of_the_origin(n, seed, time_unit, state_units, offset):
+    # in new units x = D x~, time t = a t~ and with the equilibrium moved to |x*| ~ 10^offset, the
+    # Jacobian of f~(x~) = a D^-1 f(D x~) is a D^-1 A D: every column must follow
+    rng = np.random.default_rng(seed)
+    W, A0 = rng.normal(size=(n, n)), rng.normal(size=(n, n))
+    c = rng.normal(size=n) * 10**offset   # where the equilibrium lies in the original units
+
+    def f(x, u):  # smooth, with curvature scale ~1 in the original units wherever x lies
+        return A0 @ (x - c) + np.sin(W @ (x - c))
+
+    a, D = 10.0**time_unit, 10.0 ** np.array(state_units[:n])
+    A, _ = ck.linearize(f, c)
+    A_new, _ = ck.linearize(lambda x, u: a * f(D * x, u) / D, c / D)
+    A_true = A0 + W                                    # d/dx [A0 (x - c) + sin(W (x - c))] at x = c
+    np.testing.assert_allclose(A, A_true, rtol=1e-9, atol=1e-9 * np.abs(A_true).max())
+    expected = a * A_true * D[None, :] / D[:, None]
+    # per column (the columns' sizes differ by up to 1e16 across units): 1e-8 of each column
+    scale = np.abs(expected).max(axis=0)
+    assert np.all(np.abs(A_new - expected) <= 1e-8 * scale[None, :])
+
+
+def test_nan_at_the_equilibrium_is_rejected_naming_the_function():
+    # issue 14: a NaN residual was accepted as an equilibrium (NaN > tol is False)
+    def leaky(x, u):
+        return np.array([np.nan * x[0], x[1]])
+
+    with pytest.raises(ck.UserFunctionError, match=r"f \(leaky\) returned NaN or inf at x_eq"):
+        ck.linearize(leaky, [0.0, 0.0])
+    with pytest.raises(ck.UserFunctionError, match=r"returned NaN or inf at x_eq"):
+        ck.linearize(ck.NonlinearSystem(leaky, n=2), [0.0, 0.0], check_equilibrium=False)
+
+
+def test_a_jacobian_without_usable_steps_raises():
+    # sqrt at 0: every left step is outside the domain, so no central difference exists
+    with pytest.raises(ValueError, match=r"no derivative with respect to x1 .* column 1 of A"):
+        ck.linearize(lambda x, u: np.sqrt(x), [0.0], check_equilibrium=False)
+
+
+def test_exceptions_of_f_are_wrapped_with_the_function_name():
+    def exploding_pendulum(x, u):
+        raise ZeroDivisionError("boom")
+
+    with pytest.raises(ck.UserFunctionError,
+                       match=r"f \(exploding_pendulum\) raised ZeroDivisionError at x_eq = \[0.5, 0.0\]"):
+        ck.linearize(exploding_pendulum, [0.5, 0.0], [0.0])
+    with pytest.raises(ck.UserFunctionError, match=r"exploding_pendulum\) raised ZeroDivisionError"):
+        ck.linearize(ck.NonlinearSystem(exploding_pendulum, n=2, m=1), [0.5, 0.0], [0.0])
+
+
+def test_a_model_that_raises_outside_its_domain_is_still_linearized():
+    import math
+    # math.log raises for x <= 0: the ladder's large steps (x - 1/4) are skipped, not reported
+    A, _ = ck.linearize(lambda x, u: [math.log(x[0])], [1e-3], check_equilibrium=False)
+    np.testing.assert_allclose(A, [[1e3]], rtol=1e-9)
+
+
+def test_a_jump_or_noise_in_f_gives_an_accuracy_warning():
+    with pytest.warns(ck.AccuracyWarning, match=r"column 1 of A \(d f / d x1\) is uncertain"):
+        ck.linearize(lambda x, u: np.sign(x), [0.0], check_equilibrium=False)
+
+    def noisy(x, u):  # 1e-6 of deterministic noise on a smooth function
+        rng = np.random.default_rng(abs(hash(x.tobytes())))
+        return np.sin(x) + 1e-6 * rng.normal(size=1)
+
+    with pytest.warns(ck.AccuracyWarning, match=r"error estimate .* exceeds 1e-07 of the column's size"):
+        ck.linearize(noisy, [0.3], check_equilibrium=False)
