@@ -5,6 +5,10 @@
   *algebraic* Riccati equation). It is the dual of the LQR equation: SciPy's
   ``solve_continuous_are(a, b, q, r)`` solves a^T X + X a - X b r^{-1} b^T X + q = 0,
   and with a = A^T, b = C^T this is exactly 0 = A P + P A^T - P C^T R^{-1} C P + Q.
+  With ``dt=Ts`` the same for a sampled model x(k+1) = A x(k) + w(k): the
+  discrete algebraic Riccati equation and the predictor gain of python-control's
+  ``dlqe``. Either way the result is checked (residual, P >= 0, A - L C stable).
+  The discrete-time *filter* is `coursekit.kalman_discrete.discrete_kalman_filter`.
 * `kalman_bucy` -- the time-varying filter: the observer (4.86) run on
   recorded data with the gain (4.87) and the Riccati ODE (4.88) integrated
   alongside the estimate.
@@ -22,7 +26,11 @@ variance of the samples. Conversely a sensor whose samples have variance σ²
 at the sampling period dt corresponds to the intensity **R = σ² dt**. Q and
 R in this module are intensities: Q in (state unit)²/s, R in (output unit)²·s.
 In the deterministic view of the notes Q and R are simply tuning matrices:
-only their ratio matters for the steady-state gain.
+only their ratio matters for the steady-state gain. In discrete time
+(``kalman_gain(..., dt=Ts)``, `discrete_kalman_filter`) Q and R are instead
+the *covariances* of the sampled noises w(k), v(k): R_d = R / Ts for a sensor
+of intensity R sampled every Ts, and Q_d = ∫_0^Ts e^{A s} Q e^{A^T s} ds ≈ Q Ts
+for process noise of intensity Q.
 
 Integration: both filters use the classical fixed-step Runge-Kutta method
 (RK4) between the samples of the grid, with u and y linear between samples

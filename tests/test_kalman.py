@@ -472,3 +472,15 @@ def test_ekf_catches_inf_from_h_and_errors_of_the_jacobians():
     with pytest.raises(ck.UserFunctionError, match=r"dhdx returned NaN or inf at t = 0\.[12]"):
         ck.extended_kalman_filter(linear, T11, None, Y0, x0=[1.0], **EKF_ARGS,
                                   dhdx=lambda x, u: [[np.nan if x[0] < 0.75 else 1.0]])
+
+
+def test_kalman_bucy_rejects_nan_data_by_name():
+    # NaN in the record would propagate into x̂ silently; it is refused before integrating
+    t = np.linspace(0, 1, 11)
+    y = np.zeros((11, 1))
+    y[4] = np.nan
+    with pytest.raises(ValueError, match=r"y contains NaN or infinite entries"):
+        ck.kalman_bucy(ck.StateSpace(A, B, C), t, None, y, Q, R, np.eye(2), [0, 0])
+    with pytest.raises(ValueError, match=r"u contains NaN or infinite entries"):
+        ck.kalman_bucy(ck.StateSpace(A, B, C), t, np.full((11, 1), np.inf), np.zeros((11, 1)), Q, R,
+                       np.eye(2), [0, 0])
