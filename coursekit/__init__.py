@@ -23,7 +23,7 @@ _MODULES = (
     # chapter 3: stability and state feedback
     "placement", "stability", "equilibria", "linearization", "controllers",
     # chapter 4: observability and observers
-    "observability", "observers", "kalman",
+    "observability", "observers", "kalman", "kalman_discrete",
     # course tools: figure style and layout
     "style", "layout",
     # course tools: environment check (exercises stay the subpackage coursekit.exercises)

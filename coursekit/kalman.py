@@ -5,6 +5,10 @@
   *algebraic* Riccati equation). It is the dual of the LQR equation: SciPy's
   ``solve_continuous_are(a, b, q, r)`` solves a^T X + X a - X b r^{-1} b^T X + q = 0,
   and with a = A^T, b = C^T this is exactly 0 = A P + P A^T - P C^T R^{-1} C P + Q.
+  With ``dt=Ts`` the same for a sampled model x(k+1) = A x(k) + w(k): the
+  discrete algebraic Riccati equation and the predictor gain of python-control's
+  ``dlqe``. Either way the result is checked (residual, P >= 0, A - L C stable).
+  The discrete-time *filter* is `coursekit.kalman_discrete.discrete_kalman_filter`.
 * `kalman_bucy` -- the time-varying filter: the observer (4.86) run on
   recorded data with the gain (4.87) and the Riccati ODE (4.88) integrated
   alongside the estimate.
@@ -22,7 +26,11 @@ variance of the samples. Conversely a sensor whose samples have variance σ²
 at the sampling period dt corresponds to the intensity **R = σ² dt**. Q and
 R in this module are intensities: Q in (state unit)²/s, R in (output unit)²·s.
 In the deterministic view of the notes Q and R are simply tuning matrices:
-only their ratio matters for the steady-state gain.
+only their ratio matters for the steady-state gain. In discrete time
+(``kalman_gain(..., dt=Ts)``, `discrete_kalman_filter`) Q and R are instead
+the *covariances* of the sampled noises w(k), v(k): R_d = R / Ts for a sensor
+of intensity R sampled every Ts, and Q_d = ∫_0^Ts e^{A s} Q e^{A^T s} ds ≈ Q Ts
+for process noise of intensity Q.
 
 Integration: both filters use the classical fixed-step Runge-Kutta method
 (RK4) between the samples of the grid, with u and y linear between samples
@@ -43,6 +51,7 @@ from typing import Callable
 
 import numpy as np
 
+from .diagnostics import UserFunctionError, call_user, warn_accuracy
 from ._validation import as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
 from .linearization import _jacobian, _perturbed, _quotients
 from .observability import _obs_pair
@@ -59,9 +68,16 @@ __all__ = [
 ]
 
 
-def _covariance(value, name: str, size: int, *, definite: bool) -> np.ndarray:
-    """A symmetric (size x size) matrix, positive definite or semidefinite."""
-    M = as_square(value, name, size=size)
+def _covariance(value, name: str, size: int, *, definite: bool, why: str = "") -> np.ndarray:
+    """A symmetric (size x size) matrix, positive definite or semidefinite.
+
+    `why` says where `size` comes from ("one row and column per state, since A is 2x2").
+    """
+    M = as_square(value, name)
+    if M.shape[0] != size:
+        reason = f" ({why})" if why else ""
+        raise ValueError(f"{name} has the wrong size: received shape {M.shape}, expected "
+                         f"({size}, {size}){reason}.")
     if not np.allclose(M, M.T, rtol=1e-10, atol=1e-12 * max(1.0, np.abs(M).max())):
         raise ValueError(f"{name} must be symmetric: received {M.tolist()!r}; use (M + M.T) / 2.")
     M = (M + M.T) / 2
@@ -80,60 +96,278 @@ def _covariance(value, name: str, size: int, *, definite: bool) -> np.ndarray:
     return M
 
 
-def kalman_gain(A, C, Q, R) -> tuple[np.ndarray, np.ndarray]:
+def _state_why(n: int) -> str:
+    return f"one row and column per state, since A is {n}x{n}"
+
+
+def _output_why(p: int) -> str:
+    return (f"one row and column per output, since C has {p} row{'s' if p > 1 else ''}; "
+            "if the system has another number of outputs, check C")
+
+
+def _gain_inputs(A, C, Q, R):
+    """Validate in the order the sizes come from: A (n), C (p rows), then Q (n x n), R (p x p)."""
+    A, C = _obs_pair(A, C)
+    n, p = A.shape[0], C.shape[0]
+    Q = _covariance(Q, "Q", n, definite=False, why=_state_why(n))
+    R = _covariance(R, "R", p, definite=True, why=_output_why(p))
+    return A, C, Q, R
+
+
+#: Relative Riccati residual above which kalman_gain warns (`_riccati_residual`). A
+#: well-posed equation solved by SciPy's Schur method lands orders of magnitude below
+#: (typically 1e-15..1e-10); above 1e-6 fewer than about six digits of P can be trusted.
+_RESIDUAL_TOL = 1e-6
+
+
+def kalman_gain(A, C, Q, R, *, dt=None) -> tuple[np.ndarray, np.ndarray]:
     """Steady-state Kalman gain L (n, p) and Riccati solution P (n, n).
 
-    P is the symmetric positive semidefinite solution of the algebraic
-    Riccati equation, the equilibrium of (4.88):
+    **Continuous time** (``dt=None``). P is the stabilizing solution of the
+    algebraic Riccati equation, the equilibrium of (4.88):
 
         0 = A P + P A^T - P C^T R^{-1} C P + Q,
 
     solved by duality with the LQR equation (``solve_continuous_are(A^T, C^T, Q, R)``),
-    and L = P C^T R^{-1} (4.87). The observer error then obeys
-    x̃' = (A - L C) x̃ with A - L C stable. python-control's ``lqe(A, I, C, Q, R)``
-    returns the same L (no sign flip: the observer convention is the same).
+    and L = P C^T R^{-1} (4.87), for the observer (4.86) with error x̃' = (A - L C) x̃.
+    python-control's ``lqe(A, I, C, Q, R)`` returns the same L (no sign flip: the
+    observer convention is the same). Q (n, n) >= 0 and R (p, p) > 0 are the
+    noise *intensities* (module docstring for units).
 
-    Q (n, n) >= 0 is the process-noise intensity, R (p, p) > 0 the
-    measurement-noise intensity (see the module docstring for units).
-    Needs (A, C) detectable and (A, Q^{1/2}) without uncontrollable modes on
-    the imaginary axis; otherwise a ValueError says so.
+    **Discrete time** (``dt`` = the sampling period > 0 of x(k+1) = A x(k) + w(k),
+    y(k) = C x(k) + v(k)). P is the stabilizing solution of the discrete
+    algebraic Riccati equation (``solve_discrete_are(A^T, C^T, Q, R)``)
+
+        P = A P A^T - A P C^T (C P C^T + R)^{-1} C P A^T + Q,
+
+    the steady-state covariance of the *prediction* error x(k) - x̂(k|k-1). The
+    returned gain is the **predictor gain**
+
+        L = A P C^T (C P C^T + R)^{-1},
+
+    the gain of the observer in the notes' form (4.86) written for sampled data,
+    x̂(k+1) = A x̂(k) + B u(k) + L (y(k) - C x̂(k)), error x̃(k+1) = (A - L C) x̃(k);
+    it is what python-control's ``dlqe(A, I, C, Q, R)`` returns (with the same P).
+    The filter (measurement-update) gain M = P C^T (C P C^T + R)^{-1}, used by
+    `discrete_kalman_filter` for x̂(k|k) = x̂(k|k-1) + M (y(k) - C x̂(k|k-1)), is
+    L = A M, i.e. M = A^{-1} L when A is invertible. Here Q and R are the
+    *covariances* of the sampled noises w(k) and v(k); for a continuous model
+    with intensities Q_c, R_c sampled with period dt they are about Q_c dt (exactly
+    the Van Loan integral ∫_0^dt e^{A s} Q_c e^{A^T s} ds) and R_c / dt (module
+    docstring). As dt -> 0, L / dt tends to the continuous gain.
+
+    Guarantees, checked on the result: P symmetric positive semidefinite, the
+    Riccati residual at most 1e-6 of the size of its terms (entry by entry,
+    so the test does not depend on the state units), and A - L C stable
+    (eigenvalues in the open left half plane, or inside the unit circle).
+    Raises ValueError when no stabilizing solution exists, naming the mode
+    that prevents it: a mode of A that is unstable (or on the stability
+    boundary) and not observable through C ((A, C) not detectable), or a mode
+    on the imaginary axis (unit circle) that Q does not drive, e.g. an
+    undamped oscillator or an integrator with Q = 0. Warns
+    (`AccuracyWarning`) when the residual or the semidefiniteness of P is
+    off by more than rounding explains.
     """
-    A, C = _obs_pair(A, C)
-    n, p = A.shape[0], C.shape[0]
-    Q = _covariance(Q, "Q", n, definite=False)
-    R = _covariance(R, "R", p, definite=True)
-    from scipy.linalg import solve_continuous_are
-    try:
-        # ARE (4.88 with Ṗ = 0): A P + P A^T - P C^T R^{-1} C P + Q = 0
-        P = solve_continuous_are(A.T, C.T, Q, R)
-    except (np.linalg.LinAlgError, ValueError) as err:
-        raise ValueError(
-            f"the algebraic Riccati equation has no stabilizing solution ({err}). Check that "
-            "every unstable mode of A is observable through C (is_observable) and that Q "
-            "excites every mode on the imaginary axis (try Q = np.eye(n))."
-        ) from None
-    P = (P + P.T) / 2
-    # (4.87): L = P C^T R^{-1}
-    L = np.linalg.solve(R, C @ P).T
+    A, C, Q, R = _gain_inputs(A, C, Q, R)
+    if dt is not None:
+        dt = as_scalar(dt, "dt", positive=True)
+    P = _solve_riccati(A, C, Q, R, dt)
+    if dt is None:
+        # (4.87): L = P C^T R^{-1}
+        L = np.linalg.solve(R, C @ P).T
+    else:
+        # predictor gain L = A P C^T (C P C^T + R)^{-1} = A M
+        L = A @ np.linalg.solve(C @ P @ C.T + R, C @ P).T
+    _check_riccati(A, C, Q, R, P, L, dt)
     return L, P
+
+
+def _solve_riccati(A, C, Q, R, dt):
+    """The stabilizing P of the continuous (dt None) or discrete algebraic Riccati equation."""
+    from scipy.linalg import solve_continuous_are, solve_discrete_are
+    solve = solve_continuous_are if dt is None else solve_discrete_are
+    try:
+        # continuous, (4.88) with Ṗ = 0: A P + P A^T - P C^T R^{-1} C P + Q = 0
+        # discrete: P = A P A^T - A P C^T (C P C^T + R)^{-1} C P A^T + Q
+        P = solve(A.T, C.T, Q, R)
+    except (np.linalg.LinAlgError, ValueError) as err:
+        raise _no_stabilizing_solution(A, C, dt, *_modes_of(A, Q), solver=str(err)) from None
+    if not np.all(np.isfinite(P)):
+        raise _no_stabilizing_solution(A, C, dt, *_modes_of(A, Q), solver="the solution is not finite")
+    asym = float(np.abs(P - P.T).max()) / max(float(np.abs(P).max()), 1e-300)
+    if asym > 1e-8:
+        warn_accuracy(f"kalman_gain: the Riccati solution P is not symmetric (asymmetry {asym:.1e} "
+                      "of its largest entry); it was symmetrized. The equation is badly "
+                      "conditioned: check the units of Q and R, or rescale the states.", stacklevel=4)
+    return (P + P.T) / 2
+
+
+def _riccati_residual(A, C, Q, R, P, dt) -> float:
+    """Largest |residual| of the Riccati equation relative to the size of its terms.
+
+    Entry (i, j) of the residual is divided by the same entry of the sum of
+    the absolute values of the terms, products taken of absolute values
+    (|A||P| + |P||A^T| + ...): the bound of the rounding errors made in
+    evaluating it. The ratio does not change with diagonal state scaling or
+    the time unit; for an exact P in floating point it is a few eps.
+    """
+    if dt is None:
+        G = np.linalg.solve(R, C @ P)                                     # R^{-1} C P
+        PCt = P @ C.T
+        residual = A @ P + P @ A.T - PCt @ G + Q
+        size = abs(A) @ abs(P) + abs(P) @ abs(A.T) + abs(PCt) @ abs(G) + abs(Q)
+    else:
+        APCt = A @ P @ C.T
+        G = np.linalg.solve(C @ P @ C.T + R, APCt.T)                      # S^{-1} C P A^T
+        residual = A @ P @ A.T - APCt @ G + Q - P
+        size = abs(A) @ abs(P) @ abs(A.T) + abs(APCt) @ abs(G) + abs(Q) + abs(P)
+    ratio = np.divide(abs(residual), size, out=np.zeros_like(size), where=size > 0)
+    return float(ratio.max())
+
+
+def _semidefinite_defect(P: np.ndarray) -> float:
+    """Most negative eigenvalue of P scaled to unit diagonal (a correlation matrix), >= 0 if none.
+
+    The scaling makes the test independent of the state units; a zero diagonal
+    entry (a state the filter knows exactly) is left unscaled.
+    """
+    d = np.sqrt(np.abs(np.diag(P)))
+    d[d == 0] = 1.0
+    return max(0.0, -float(np.linalg.eigvalsh(P / np.outer(d, d)).min()))
+
+
+def _unstable_modes(M: np.ndarray, dt):
+    """Eigenvalues (and eigenvectors) of M not strictly stable, within rounding.
+
+    Continuous: Re λ >= -tol; discrete: |λ| >= 1 - tol, tol = 1000 eps times
+    the norm of M after balancing (`scipy.linalg.matrix_balance`, so that the
+    tolerance does not depend on the state units).
+    """
+    from scipy.linalg import matrix_balance
+    lam, V = np.linalg.eig(M)
+    size = float(np.linalg.norm(matrix_balance(M, permute=False)[0], 1))
+    tol = 1e3 * np.finfo(float).eps * (size if dt is None else max(size, 1.0))
+    margin = -lam.real if dt is None else 1.0 - np.abs(lam)
+    bad = margin <= tol
+    return lam[bad], V[:, bad], tol
+
+
+def _check_riccati(A, C, Q, R, P, L, dt) -> None:
+    """Raise if A - L C is not stable; warn if the residual or P >= 0 is off (`kalman_gain`)."""
+    lam, V, _ = _unstable_modes(A - L @ C, dt)
+    if lam.size:
+        raise _no_stabilizing_solution(A, C, dt, lam, V, closed_loop=True)
+    residual = _riccati_residual(A, C, Q, R, P, dt)
+    if residual > _RESIDUAL_TOL:
+        warn_accuracy(
+            f"kalman_gain: the Riccati equation is solved only to {residual:.1e} of the size of "
+            f"its terms (rounding explains up to {_RESIDUAL_TOL:.0e}), so L and P are inaccurate. "
+            "The equation is badly conditioned: check the units of Q and R (their ratio sets "
+            "the gain), a nearly unobservable mode (obsv_singular_values), or rescale the states.",
+            stacklevel=4)
+    defect = _semidefinite_defect(P)
+    if defect > 1e-8:
+        warn_accuracy(
+            f"kalman_gain: P is not positive semidefinite (eigenvalue {-defect:.1e} after scaling "
+            "P to unit diagonal); the solution is inaccurate. Check the units of Q and R, or "
+            "rescale the states.", stacklevel=4)
+
+
+def _modes_of(A, Q):
+    """Eigenvalues of A, right eigenvectors, and whether Q drives each mode (w^H Q w > 0 for
+    the left eigenvector w, relative to |Q| |w|^2)."""
+    from scipy.linalg import eig
+    lam, W, V = eig(A, left=True, right=True)
+    drive = np.einsum("ik,ij,jk->k", W.conj(), Q, W).real
+    driven = drive > 1e-8 * max(float(np.linalg.norm(Q, 2)), 1e-300) * np.sum(abs(W) ** 2, axis=0)
+    return lam, V, driven
+
+
+def _fmt_mode(lam: complex) -> str:
+    if abs(lam.imag) <= 1e-12 * abs(lam):
+        return f"{lam.real:.4g}"
+    return f"{lam.real:.4g} ± {abs(lam.imag):.4g}j"
+
+
+def _mode_reason(A, C, lam, v, dt, tol, closed_loop: bool, driven: bool) -> str | None:
+    """Why the mode (lam, v) prevents a stabilizing solution, or None if it does not."""
+    where = "on the imaginary axis" if dt is None else "on the unit circle"
+    margin = -lam.real if dt is None else 1.0 - abs(lam)
+    kind = where if abs(margin) <= tol else "unstable"
+    v = v / v[np.argmax(np.abs(v))]
+    shown = np.array2string(v.real if np.isrealobj(v) or not np.abs(v.imag).any() else v,
+                            precision=3, suppress_small=True)
+    if np.linalg.norm(C @ v) <= 1e-8 * np.linalg.norm(C, 2) * np.linalg.norm(v):
+        return (f"the mode λ = {_fmt_mode(lam)} of A (eigenvector {shown}) is {kind} and not "
+                "observable through C (C v = 0): y carries no trace of it, so no gain L can "
+                "move it ((A, C) is not detectable). Measure it (add a row to C that sees "
+                "this mode) or remove it from the model.")
+    if kind == where and not driven:
+        return (f"the mode λ = {_fmt_mode(lam)} of A (eigenvector {shown}) lies {where} and the "
+                "process noise Q does not drive it: the model then claims this undamped mode "
+                "is known exactly, the steady-state gain leaves it uncorrected and the "
+                "estimation error never decays. Let Q act on it (e.g. Q = q * np.eye(n) with "
+                "a small q > 0), or use the time-varying filter, whose gain decays.")
+    if closed_loop:
+        return (f"the solver returned a solution that is not stabilizing (A - L C has the "
+                f"unstable eigenvalue {_fmt_mode(lam)}): the equation is too badly conditioned; "
+                "check the units of Q and R, or rescale the states.")
+    return None
+
+
+def _no_stabilizing_solution(A, C, dt, lam, V, driven=None, *, solver: str = "",
+                             closed_loop: bool = False) -> ValueError:
+    """The ValueError of `kalman_gain`, naming the modes of A that prevent a stabilizing P.
+
+    `lam`, `V` are the suspect eigenpairs: those of A - L C that are not
+    stable (closed_loop; a mode on the boundary that y sees is then one that
+    Q does not drive), or all of A with `driven` (`_modes_of`) when the
+    solver failed.
+    """
+    driven = np.zeros(lam.size, bool) if driven is None else driven
+    _, _, tol = _unstable_modes(A, dt)
+    reasons = []
+    for k in range(lam.size):
+        if lam[k].imag < 0:                                  # one of each conjugate pair
+            continue
+        margin = -lam[k].real if dt is None else 1.0 - abs(lam[k])
+        if not closed_loop and margin > tol:                 # a stable mode of A is harmless
+            continue
+        reason = _mode_reason(A, C, lam[k], V[:, k], dt, tol, closed_loop, driven[k])
+        if reason:
+            reasons.append(reason)
+    boundary = "the imaginary axis" if dt is None else "the unit circle"
+    detail = " ".join(reasons) if reasons else (
+        f"(the solver said: {solver}). Check that every unstable mode of A is observable "
+        f"through C (is_observable) and that Q drives every mode on {boundary} (try Q = np.eye(n)).")
+    return ValueError(
+        f"kalman_gain: the algebraic Riccati equation has no stabilizing solution (A - L C "
+        f"would not be stable): {detail} A stabilizing solution needs (A, C) detectable and "
+        f"no mode on {boundary} that Q leaves undriven.")
 
 
 @dataclass(repr=False)
 class KalmanResult:
-    """What the Kalman-Bucy filter and the EKF return (time-major).
+    """What the Kalman filters return (time-major).
 
     Attributes
     ----------
-    t : (N,) array      -- the time grid
-    x : (N, n) array    -- the estimate x̂ at each time
-    P : (N, n, n) array -- the solution of the Riccati equation (4.88)
-    L : (N, n, p) array -- the gain L(t) = P C^T R^{-1} (4.87)
+    t : (N,) array      -- the time grid (k dt for `discrete_kalman_filter`)
+    x : (N, n) array    -- the estimate x̂ at each time (in discrete time the
+                           filtered estimate x̂(k|k), given y(0), ..., y(k))
+    P : (N, n, n) array -- its error covariance: the solution of the Riccati
+                           equation (4.88), in discrete time P(k|k)
+    L : (N, n, p) array -- the observer gain: L(t) = P C^T R^{-1} (4.87); in
+                           discrete time the predictor gain L(k) = A M(k)
+    M : (N, n, p) array or None -- discrete time only: the update gain M(k),
+                           x̂(k|k) = x̂(k|k-1) + M(k) (y(k) - ŷ(k|k-1))
     """
 
     t: np.ndarray
     x: np.ndarray
     P: np.ndarray
     L: np.ndarray
+    M: np.ndarray | None = None
 
     @property
     def sigma(self) -> np.ndarray:
@@ -143,7 +377,8 @@ class KalmanResult:
     def __repr__(self) -> str:
         n, p = self.L.shape[1:]
         return (f"KalmanResult: {self.t.size} samples from t={self.t[0]:g} to t={self.t[-1]:g}; "
-                f"x {self.x.shape}, P (N, {n}, {n}), L (N, {n}, {p})")
+                f"x {self.x.shape}, P (N, {n}, {n}), L (N, {n}, {p})"
+                + ("" if self.M is None else f", M (N, {n}, {p})"))
 
 
 def _records(t, u, y, m: int):
@@ -226,8 +461,8 @@ def _diverged(t_k: float) -> RuntimeError:
         "model, the units of Q and R, and try substeps=10.")
 
 
-def _rk4_interval(rhs, x, P, cur, w0, w1, dt: float, substeps: int):
-    """RK4 on (4.91) and (4.88) from one sample to the next, w = [u, y] linear in between.
+def _rk4_interval(rhs, x, P, cur, w0, w1, t0: float, dt: float, substeps: int):
+    """RK4 on (4.91) and (4.88) from t0 to the next sample t0 + dt, w = [u, y] linear in between.
 
     The step is at most dt / substeps and at most 0.5 / rate, the rate of
     (4.88) at the current P, so a fast start (large P0, small R) takes many
@@ -241,30 +476,31 @@ def _rk4_interval(rhs, x, P, cur, w0, w1, dt: float, substeps: int):
         h = _next_step(tau, dt, substeps, M)
         # w linear over the interval: w0 + s (w1 - w0) at s = (tau + h/2)/dt and (tau + h)/dt
         w_mid, w_end = w0 + (tau + h / 2) / dt * dw, w0 + (tau + h) / dt * dw
-        k2x, k2P, _, _ = rhs(x + h / 2 * k1x, P + h / 2 * k1P, w_mid)
-        k3x, k3P, _, _ = rhs(x + h / 2 * k2x, P + h / 2 * k2P, w_mid)
-        k4x, k4P, _, _ = rhs(x + h * k3x, P + h * k3P, w_end)
+        t_mid, t_end = t0 + tau + h / 2, t0 + tau + h
+        k2x, k2P, _, _ = rhs(x + h / 2 * k1x, P + h / 2 * k1P, w_mid, t_mid)
+        k3x, k3P, _, _ = rhs(x + h / 2 * k2x, P + h / 2 * k2P, w_mid, t_mid)
+        k4x, k4P, _, _ = rhs(x + h * k3x, P + h * k3P, w_end, t_end)
         x = x + h / 6 * (k1x + 2 * k2x + 2 * k3x + k4x)
         P = P + h / 6 * (k1P + 2 * k2P + 2 * k3P + k4P)
         P = (P + P.T) / 2
         if not _finite(x, P):
             return x, P, None
         tau, steps = _advance(tau, h, dt, steps)
-        cur = rhs(x, P, w_end)
+        cur = rhs(x, P, w_end, t_end)
     return x, P, cur
 
 
 def _ekf_rhs(model, Q, R, m: int):
-    """rhs(x, P, w) -> (x̂', P', L, A - L C) of (4.91), (4.88), (4.87) at w = [u, y].
+    """rhs(x, P, w, t) -> (x̂', P', L, A - L C) of (4.91), (4.88), (4.87) at w = [u, y], time t.
 
     Products are written ``a.dot(b)``: the same numbers as ``a @ b``, with half
     the call overhead on these small arrays (rhs runs four times per RK4 step).
     """
     Rinv = np.linalg.inv(R)
 
-    def rhs(x, P, w):
+    def rhs(x, P, w, t):
         u, y = w[:m], w[m:]
-        fx, hx, A, C = model(x, u)
+        fx, hx, A, C = model(x, u, t)
         # (4.87): L = P C^T R^{-1}
         L = P.dot(C.T).dot(Rinv)
         # (4.91): x̂' = f(x̂, u) + L (y - h(x̂, u))
@@ -279,11 +515,11 @@ def _run_filter(rhs, t, w, P0, x0, substeps: int) -> KalmanResult:
     """Integrate (4.91) and (4.87)-(4.88) with RK4 on the grid t (w = [u, y] per sample)."""
     N = t.size
     x, P = x0.copy(), P0.copy()
-    cur = rhs(x, P, w[0])
+    cur = rhs(x, P, w[0], t[0])
     xs, Ps, Ls = np.empty((N,) + x.shape), np.empty((N,) + P.shape), np.empty((N,) + cur[2].shape)
     for k, dt in enumerate(np.diff(t).tolist()):
         xs[k], Ps[k], Ls[k] = x, P, cur[2]
-        x, P, cur = _rk4_interval(rhs, x, P, cur, w[k], w[k + 1], dt, substeps)
+        x, P, cur = _rk4_interval(rhs, x, P, cur, w[k], w[k + 1], t[k], dt, substeps)
         if cur is None:
             raise _diverged(t[k + 1])
     xs[-1], Ps[-1], Ls[-1] = x, P, cur[2]
@@ -401,12 +637,16 @@ def _substeps(substeps) -> int:
     return int(as_scalar(substeps, "substeps", positive=True, integer=True))
 
 
+def _initial_estimate(x0, n: int) -> np.ndarray:
+    return as_vector(x0, "x0", size=n, why="the initial estimate x̂(0), one entry per state")
+
+
 def _filter_setup(n: int, p: int, Q, R, P0, x0):
-    Q = _covariance(Q, "Q", n, definite=False)
-    R = _covariance(R, "R", p, definite=True)
-    P0 = _covariance(P0, "P0", n, definite=True)
-    x0 = as_vector(x0, "x0", size=n, why="the initial estimate x̂(0), one entry per state")
-    return Q, R, P0, x0
+    """Validate the weights (sizes explained from n and p) and the initial P0, x̂(0)."""
+    Q = _covariance(Q, "Q", n, definite=False, why=f"one row and column per state, n = {n}")
+    R = _covariance(R, "R", p, definite=True, why=f"one row and column per output, p = {p}")
+    P0 = _covariance(P0, "P0", n, definite=True, why=f"one row and column per state, n = {n}")
+    return Q, R, P0, _initial_estimate(x0, n)
 
 
 def kalman_bucy(sys, t, u, y, Q, R, P0, x0, *, substeps: int = 1) -> KalmanResult:
@@ -444,52 +684,98 @@ def _accepts_batches(fun, x0: np.ndarray, u0: np.ndarray) -> bool:
     fun(x, u) on single states (within 1e-12), checked on the states of `_perturbed(x0)`.
 
     The test of `simulation._check_batch`, but a function written for one state at a
-    time (``float(x[0])``, ``if x[0] > 0``, ...) is an answer, not an error.
+    time (``float(x[0])``, ``if x[0] > 0``, ...) is an answer, not an error; so is a
+    function that raises here (it is then called one state at a time, and an error it
+    raises there is reported with its context).
     """
     X, _ = _perturbed(x0)
     U = u0[:, None].repeat(X.shape[1], axis=1)
     try:
         batch = np.asarray(fun(X, U), dtype=float)
+        return _agrees_column_by_column(fun, X, U, batch)
     except Exception:                   # written for one state at a time
         return False
-    return _agrees_column_by_column(fun, X, U, batch)
+
+
+def _at(t: float) -> str:
+    return f"at t = {t:.6g}"
+
+
+def _user(fun, name: str, *, batch: bool = False):
+    """(x, u, t) -> fun(x, u) as a finite float array, or a `UserFunctionError` naming
+    `name` and the time t (`diagnostics.call_user`).
+
+    Fast path: a finite float array is returned as is. Anything else (an
+    exception, NaN/inf, complex, not numbers) is handed to `call_user`, which
+    calls fun again and reports it; the EKF calls f and h four times per
+    RK4 step, so the common case costs one sum, not a full check.
+    """
+    extra = " (on x̂ and its central-difference neighbours, as columns)" if batch else ""
+
+    def call(x, u, t):
+        try:
+            out = fun(x, u)
+            if isinstance(out, np.ndarray) and out.dtype == float and _finite(out):
+                return out
+        except Exception:                   # reported with its context by call_user below
+            pass
+        return call_user(fun, (x, u), name, where=_at(t) + extra)
+    return call
+
+
+def _user_jacobian(fun, name: str, shape: tuple[int, int], what: str):
+    """(x, u, t) -> the user's Jacobian fun(x, u) of the given shape, checked like `_user`."""
+    call = _user(fun, name)
+
+    def jacobian(x, u, t):
+        J = call(x, u, t)
+        if J.size != shape[0] * shape[1]:
+            raise UserFunctionError(f"{name} returned shape {J.shape} {_at(t)}; expected {shape} "
+                                    f"({what}).")
+        return J.reshape(shape)
+    return jacobian
 
 
 def _batched_model(f, h, n: int):
-    """(x, u) -> (f, h, ∂f/∂x, ∂h/∂x) at (x, u) from one call of f and one of h on the
+    """(x, u, t) -> (f, h, ∂f/∂x, ∂h/∂x) at (x, u) from one call of f and one of h on the
     batch of `_perturbed(x)`: x and its 2n central-difference neighbours as columns."""
     cols = 2 * n + 1
+    f, h = _user(f, "f", batch=True), _user(h, "h", batch=True)
 
-    def model(x, u):
+    def model(x, u, t):
         X, step = _perturbed(x)
         U = u[:, None].repeat(cols, axis=1)
-        G = np.concatenate((f(X, U).reshape(-1, cols), h(X, U).reshape(-1, cols)))
+        G = np.concatenate((f(X, U, t).reshape(-1, cols), h(X, U, t).reshape(-1, cols)))
         J = _quotients(G, step)
         return G[:n, -1], G[n:, -1], J[:n], J[n:]
     return model
 
 
 def _ekf_model(sys, p: int, dfdx, dhdx, x0, u0):
-    """(x, u) -> (f(x, u), h(x, u), A, C), A and C the Jacobians (4.92)-(4.93).
+    """(x, u, t) -> (f(x, u), h(x, u), A, C), A and C the Jacobians (4.92)-(4.93).
 
     dfdx and dhdx where given, else central differences (step ~ eps^(1/3),
     those of `linearize` without its refinement). When both are numerical
     and f and h accept a batch of states (`_accepts_batches`, checked once
     here, as it holds for every `coursekit.models` system), each is called
     once per evaluation (`_batched_model`); otherwise once per perturbed state.
+    Every call of f, h, dfdx, dhdx goes through `call_user`: an exception or
+    NaN/inf is reported as a `UserFunctionError` naming the function and t.
     """
     for fun, name in ((dfdx, "dfdx"), (dhdx, "dhdx")):
         if fun is not None and not callable(fun):
             raise ValueError(f"{name} must be a function (x, u) -> Jacobian, or None for "
                              f"numerical differences: received {type(fun).__name__}.")
-    f, h, n = sys.f, sys.h, sys.n
-    if dfdx is None and dhdx is None and _accepts_batches(f, x0, u0) and _accepts_batches(h, x0, u0):
-        return _batched_model(f, h, n)
-    jf = (lambda x, v: np.asarray(dfdx(x, v), float).reshape(n, n)) if dfdx else \
-        (lambda x, v: _jacobian(lambda z: f(z, v), x, refine=False))
-    jh = (lambda x, v: np.asarray(dhdx(x, v), float).reshape(p, n)) if dhdx else \
-        (lambda x, v: _jacobian(lambda z: h(z, v), x, refine=False))
-    return lambda x, v: (f(x, v), h(x, v), jf(x, v), jh(x, v))
+    n = sys.n
+    if dfdx is None and dhdx is None and _accepts_batches(sys.f, x0, u0) \
+            and _accepts_batches(sys.h, x0, u0):
+        return _batched_model(sys.f, sys.h, n)
+    f, h = _user(sys.f, "f"), _user(sys.h, "h")
+    jf = _user_jacobian(dfdx, "dfdx", (n, n), "∂f/∂x (4.92), n x n") if dfdx else \
+        (lambda x, v, t: _jacobian(lambda z: f(z, v, t), x, refine=False))
+    jh = _user_jacobian(dhdx, "dhdx", (p, n), "∂h/∂x (4.93), p x n") if dhdx else \
+        (lambda x, v, t: _jacobian(lambda z: h(z, v, t), x, refine=False))
+    return lambda x, v, t: (f(x, v, t), h(x, v, t), jf(x, v, t), jh(x, v, t))
 
 
 def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None = None,
@@ -506,16 +792,25 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
     Q, R are intensities, P0 > 0 the initial P, x0 the initial estimate.
     Unlike the linear filter, the EKF has no optimality guarantee and may
     diverge from a poor x0 or with badly chosen Q, R.
+
+    Errors: every call of f, h, dfdx and dhdx is checked; an exception it
+    raises, or NaN/inf it returns, becomes a `UserFunctionError` (a
+    ValueError) naming the function and the time t. A divergent estimate
+    (non-finite x̂ or P) raises RuntimeError with the time; the number of
+    RK4 steps per sample interval is bounded, so no call can hang.
     """
     if not isinstance(sys, NonlinearSystem) or sys.is_discrete:
         raise ValueError(f"sys must be a continuous-time NonlinearSystem: received {sys!r}; "
                          "for a StateSpace use kalman_bucy.")
     t, u, y = _records(t, u, y, sys.m)
-    Q, R, P0, x0 = _filter_setup(sys.n, y.shape[1], Q, R, P0, x0)
-    p_h = sys.output_size(x0, u[0])
+    x0 = _initial_estimate(x0, sys.n)
+    _user(sys.f, "f")(x0, u[0], t[0])
+    sys.check(x0, u[0])
+    p_h = _user(sys.h, "h")(x0, u[0], t[0]).size
     if p_h != y.shape[1]:
         raise ValueError(f"y has the wrong number of columns: received {y.shape[1]}, expected "
                          f"{p_h} (the number of outputs of sys.h).")
+    Q, R, P0, x0 = _filter_setup(sys.n, p_h, Q, R, P0, x0)
     model = _ekf_model(sys, p_h, dfdx, dhdx, x0, u[0])
     return _run_filter(_ekf_rhs(model, Q, R, sys.m), t, np.hstack([u, y]), P0, x0,
                        _substeps(substeps))

@@ -1,6 +1,7 @@
 """kalman_gain, the Kalman-Bucy filter, the EKF and the noise helpers (section 4.7)."""
 
 import math
+import re
 
 import control
 import numpy as np
@@ -342,3 +343,144 @@ def test_filters_report_divergence_and_too_many_steps(monkeypatch):
         ck.kalman_bucy(ck.StateSpace(A, B, C), t, None, np.zeros((11, 1)), **fast)
     with pytest.raises(RuntimeError, match=r"needs more than 50 RK4 steps between two samples"):
         ck.extended_kalman_filter(ck.models.pendulum(), t, None, np.zeros((11, 1)), **fast)
+
+
+# --- kalman_gain checks itself (issue 14) ------------------------------------------------------
+
+@pytest.mark.parametrize("A_, C_, mode", [
+    (np.array([[0, 1], [-1, 0.0]]), C, r"0 ± 1j"),               # undamped oscillator
+    (np.array([[0, 1], [0, 0.0]]), C, r"0"),                      # double integrator
+])
+def test_kalman_gain_refuses_an_undriven_mode_on_the_imaginary_axis(A_, C_, mode):
+    # with Q = 0 SciPy returns P = 0, so L = 0 and A - L C = A is not stable: an error, not a gain
+    with pytest.raises(ValueError, match=rf"no stabilizing solution \(A - L C would not be stable\): "
+                                         rf"the mode λ = {mode} of A .*lies on the imaginary axis and the "
+                                         r"process noise Q does not drive it.*Q = q \* np\.eye\(n\)"):
+        ck.kalman_gain(A_, C_, np.zeros((2, 2)), R)
+    L, _ = ck.kalman_gain(A_, C_, 1e-6 * np.eye(2), R)         # a little Q is enough
+    assert np.linalg.eigvals(A_ - L @ C_).real.max() < 0
+
+
+def test_kalman_gain_accepts_an_undriven_stable_mode_far_from_the_fast_ones():
+    # Q = 0 and stable A: P = 0 and L = 0 are right (A - L C = A is stable), even with poles spread
+    # over eight decades (the tolerance for "on the axis" scales with the balanced norm of A)
+    A_ = -np.diag([1.0, 1e4, 1e8])
+    L, P = ck.kalman_gain(A_, np.ones((1, 3)), np.zeros((3, 3)), [[1.0]])
+    assert np.all(L == 0) and np.all(P == 0)
+
+
+def test_kalman_gain_undetectable_names_the_mode():
+    with pytest.raises(ValueError, match=r"the mode λ = 1 of A \(eigenvector \[1\. 0\.\]\) is unstable "
+                                         r"and not observable through C \(C v = 0\).*change|the mode"):
+        ck.kalman_gain(np.diag([1.0, -1.0]), [[0, 1]], np.diag([0.0, 1.0]), [[1]])
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    (dict(C=np.eye(2)), r"R has the wrong size: received shape \(1, 1\), expected \(2, 2\) \(one row and "
+                        r"column per output, since C has 2 rows; if the system has another number of "
+                        r"outputs, check C\)"),
+    (dict(C=[[1, 0, 0]]), r"C has the wrong number of columns"),
+    (dict(Q=np.eye(3)), r"Q has the wrong size: received shape \(3, 3\), expected \(2, 2\) \(one row and "
+                        r"column per state, since A is 2x2\)"),
+    (dict(A=np.eye(3), Q=np.eye(3)), r"C has the wrong number of columns"),
+])
+def test_kalman_gain_errors_name_the_argument(kwargs, message):
+    with pytest.raises(ValueError, match=message):
+        ck.kalman_gain(**(dict(A=A, C=C, Q=Q, R=R) | kwargs))
+
+
+def _perturbed_solver(monkeypatch, change):
+    import scipy.linalg
+    exact = scipy.linalg.solve_continuous_are
+    monkeypatch.setattr(scipy.linalg, "solve_continuous_are", lambda *a: change(exact(*a)))
+
+
+def test_kalman_gain_warns_about_a_large_residual(monkeypatch):
+    # a solver that returns P 1e-4 off: still stabilizing, but the residual is ~1e-4 of its terms
+    _perturbed_solver(monkeypatch, lambda P: P * (1 + 1e-4))
+    with pytest.warns(ck.AccuracyWarning, match=r"solved only to [0-9.]+e-0[45] of the size of its terms"):
+        ck.kalman_gain(A, C, Q + 0.1 * np.eye(2), R)
+
+
+def test_kalman_gain_warns_about_an_indefinite_p(monkeypatch):
+    # P with a negative eigenvalue (the stabilizing solution is always >= 0)
+    def indefinite(P):
+        # move the smallest eigenvalue of P to -1e-3 of the largest, keep the eigenvectors
+        vals, vecs = np.linalg.eigh(P)
+        vals[0] = -1e-3 * vals[-1]
+        return (vecs * vals) @ vecs.T
+    _perturbed_solver(monkeypatch, indefinite)
+    with pytest.warns(ck.AccuracyWarning) as record:          # the residual is off as well
+        ck.kalman_gain(A, C, Q + 0.1 * np.eye(2), R)
+    assert any(re.search(r"P is not positive semidefinite \(eigenvalue -[0-9.e-]+ after scaling",
+                         str(w.message)) for w in record)
+
+
+def test_kalman_gain_residual_check_is_quiet_on_exact_solutions():
+    # the explorer's slider range (log10 Q in -4..3, log10 R in -6..0) on the vehicle with GPS: no
+    # warning may appear (pytest turns them into errors), and the relative residual is tiny
+    from coursekit.kalman import _riccati_residual
+    veh = ck.models.vehicle(m=1.0, d=1.0, sensor="gps")
+    for q in np.arange(-4, 3.1, 1.0):
+        for r in np.arange(-6, 0.1, 1.0):
+            Q_, R_ = np.diag([0.0, 10**q]), np.array([[10**r]])
+            L, P = ck.kalman_gain(veh.A, veh.C, Q_, R_)
+            assert _riccati_residual(veh.A, veh.C, Q_, R_, P, None) < 1e-12
+
+
+# --- the EKF reports errors of the user's functions with their time -----------------------------
+
+def _scalar_system(f, h=lambda x, u: 0 * x):
+    return ck.NonlinearSystem(f, n=1, h=h)
+
+
+T11, Y0 = np.linspace(0, 1, 11), np.zeros((11, 1))
+EKF_ARGS = dict(Q=[[0.0]], R=[[1.0]], P0=[[1.0]])
+
+
+def test_ekf_wraps_an_exception_of_f_with_its_name_and_time():
+    with pytest.raises(ck.UserFunctionError, match=r"f raised ZeroDivisionError at t = 0") as info:
+        ck.extended_kalman_filter(_scalar_system(lambda x, u: 1 / 0), T11, None, Y0, x0=[0.0], **EKF_ARGS)
+    assert isinstance(info.value.__cause__, ZeroDivisionError)
+
+
+@pytest.mark.filterwarnings("ignore:invalid value encountered:RuntimeWarning")
+@pytest.mark.parametrize("batched", [True, False])
+def test_ekf_catches_nan_from_f_at_the_time_it_appears(batched):
+    # x̂' = -1 from x̂ = 0.45, y carries no information: x̂ and its difference neighbours go below 0
+    # (sqrt -> NaN) shortly before t = 0.45. Written for batches or for one state (float) at a time.
+    if batched:
+        f = lambda x, u: -1 + 0 * np.sqrt(x)
+    else:
+        f = lambda x, u: np.array([-1 + 0 * np.sqrt(float(x[0]))])
+    with pytest.raises(ck.UserFunctionError, match=r"f returned NaN or inf at t = 0\.4"):
+        ck.extended_kalman_filter(_scalar_system(f), T11, None, Y0, x0=[0.45], **EKF_ARGS)
+
+
+def test_ekf_catches_inf_from_h_and_errors_of_the_jacobians():
+    # x̂' = -x̂ + L (1 - x̂) from 1 falls below 0.5 (h -> inf) after t = ln 2 = 0.69, before t = 1
+    sys_ = _scalar_system(lambda x, u: -x, h=lambda x, u: x / 0.0 if x[0] < 0.5 else x)
+    with np.errstate(divide="ignore"), \
+            pytest.raises(ck.UserFunctionError, match=r"h returned NaN or inf at t = 0\.[7-9]"):
+        ck.extended_kalman_filter(sys_, T11, None, np.ones((11, 1)), x0=[1.0], **EKF_ARGS)
+    linear = _scalar_system(lambda x, u: -x, h=lambda x, u: x)
+    with pytest.raises(ck.UserFunctionError, match=r"dfdx raised KeyError at t = 0"):
+        ck.extended_kalman_filter(linear, T11, None, Y0, x0=[1.0], dfdx=lambda x, u: {}["a"], **EKF_ARGS)
+    with pytest.raises(ck.UserFunctionError, match=r"dhdx returned shape \(2,\) at t = 0; expected \(1, 1\)"):
+        ck.extended_kalman_filter(linear, T11, None, Y0, x0=[1.0], dhdx=lambda x, u: [1.0, 2.0], **EKF_ARGS)
+    # x̂' = -(1 + L) x̂ with 0 < L <= 1 from 1 falls below 0.75 between t = ln(4/3) / 2 and ln(4/3)
+    with pytest.raises(ck.UserFunctionError, match=r"dhdx returned NaN or inf at t = 0\.[12]"):
+        ck.extended_kalman_filter(linear, T11, None, Y0, x0=[1.0], **EKF_ARGS,
+                                  dhdx=lambda x, u: [[np.nan if x[0] < 0.75 else 1.0]])
+
+
+def test_kalman_bucy_rejects_nan_data_by_name():
+    # NaN in the record would propagate into x̂ silently; it is refused before integrating
+    t = np.linspace(0, 1, 11)
+    y = np.zeros((11, 1))
+    y[4] = np.nan
+    with pytest.raises(ValueError, match=r"y contains NaN or infinite entries"):
+        ck.kalman_bucy(ck.StateSpace(A, B, C), t, None, y, Q, R, np.eye(2), [0, 0])
+    with pytest.raises(ValueError, match=r"u contains NaN or infinite entries"):
+        ck.kalman_bucy(ck.StateSpace(A, B, C), t, np.full((11, 1), np.inf), np.zeros((11, 1)), Q, R,
+                       np.eye(2), [0, 0])
