@@ -23,6 +23,9 @@ __all__ = [
     "as_time_grid",
     "is_uniform",
     "as_poles",
+    "as_integer",
+    "as_text",
+    "time_grid",
     "check_function_output",
 ]
 
@@ -50,9 +53,26 @@ def _is_complex(value) -> bool:
     return False
 
 
+def _is_text(value) -> bool:
+    """True for a string, or a list/array of strings ("1.0" is text, not a number)."""
+    if isinstance(value, (str, bytes)):
+        return True
+    if isinstance(value, (list, tuple, np.ndarray)):
+        try:
+            return np.asarray(value).dtype.kind in "US"
+        except (TypeError, ValueError):
+            return False
+    return False
+
+
 def _to_float_array(value, name: str) -> np.ndarray:
     if value is None:
         raise ValueError(f"{name} is missing: received None, expected a number or an array.")
+    if _is_text(value):
+        raise ValueError(
+            f"{name} must contain real numbers: received the text {value!r}; type the numbers "
+            "themselves, e.g. 0.5 or [[0, 1], [-2, -3]], without quotes."
+        )
     if _is_complex(value):
         raise ValueError(
             f"{name} must contain real numbers: received {_describe(value)} with complex "
@@ -165,6 +185,31 @@ def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False
     if integer and x != round(x):
         raise ValueError(f"{name} must be a whole number: received {x!r}.")
     return x
+
+
+def as_integer(value, name: str, *, minimum: int | None = None, why: str = "") -> int:
+    """Return `value` as an int, checking it is a finite whole number (>= `minimum`)."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be a whole number: received {value!r}.")
+    k = int(as_scalar(value, name, integer=True))
+    if minimum is not None and k < minimum:
+        reason = f" ({why})" if why else ""
+        raise ValueError(f"{name} must be at least {minimum}: received {k}{reason}.")
+    return k
+
+
+def as_text(value, name: str, *, expected: str = "a string") -> str:
+    """Return `value` when it is a string, else raise naming `name`."""
+    if not isinstance(value, str):
+        raise ValueError(f"{name} must be {expected}: received {_describe(value)}.")
+    return value
+
+
+def time_grid(t_end, samples, *, t_end_name: str = "t_end") -> np.ndarray:
+    """``np.linspace(0, t_end, samples)`` after checking t_end > 0 and samples >= 2 (named)."""
+    t_end = as_scalar(t_end, t_end_name, positive=True)
+    samples = as_integer(samples, "samples", minimum=2, why="a time grid needs a start and an end")
+    return np.linspace(0.0, t_end, samples)
 
 
 def as_time_grid(t, name: str = "t", *, min_points: int = 2) -> np.ndarray:
