@@ -40,14 +40,25 @@ def _describe(value) -> str:
 
 
 def _is_complex(value) -> bool:
-    """True for complex numbers or arrays, even when their imaginary parts are zero."""
+    """True for complex numbers or arrays, even when their imaginary parts are zero.
+
+    Covers Python and numpy complex scalars and arrays, lists of them, and
+    sympy numbers or matrices whose entries are complex (e.g. ``1 + I``).
+    """
     if isinstance(value, (complex, np.complexfloating)):
         return True
-    if isinstance(value, np.ndarray):
-        return np.iscomplexobj(value)
-    if isinstance(value, (list, tuple)):
+    if isinstance(value, np.ndarray) and value.dtype.kind != "O":
+        return value.dtype.kind == "c"
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):
+        return False
+    if arr.dtype.kind == "c":
+        return True
+    if arr.dtype.kind == "O":
+        # sympy numbers and matrices: complex when some entry has an imaginary part
         try:
-            return np.iscomplexobj(np.asarray(value))
+            return bool(np.any(np.asarray(value, dtype=complex).imag != 0))
         except (TypeError, ValueError):
             return False
     return False

@@ -24,6 +24,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from .._validation import _is_complex
+
 __all__ = [
     "Report",
     "close",
@@ -76,18 +78,6 @@ def _is_sympy(value) -> bool:
     return type(value).__module__.split(".")[0] == "sympy"
 
 
-def _complex_entries(value) -> bool:
-    """True when `value` holds complex numbers (numpy, Python or sympy), even with zero imaginary part."""
-    from .._validation import _is_complex
-    if _is_complex(value):
-        return True
-    try:
-        values = np.asarray(value, dtype=complex)
-    except (TypeError, ValueError):
-        return False
-    return bool(np.any(values.imag != 0))
-
-
 def _has_text(value) -> bool:
     """True when some entry of `value` is a string ("1" is text, not the number 1)."""
     try:
@@ -112,7 +102,7 @@ def _to_array(value, name: str, report: Report, *, dtype=float) -> np.ndarray | 
     if callable(value) and not _is_sympy(value):
         report.add(f"{name} is a function: call it and pass its result (numbers), not the function.")
         return None
-    if dtype is float and _complex_entries(value):
+    if dtype is float and _is_complex(value):
         report.add(f"{name} contains complex numbers: the answer is real. If the imaginary parts are "
                    "rounding noise from a computation (e.g. np.linalg.eig), pass np.real(...) of it; "
                    "otherwise recheck the computation.")
