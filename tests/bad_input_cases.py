@@ -207,6 +207,15 @@ def linear_f(x, u):
     return A2 @ np.asarray(x) + B2 @ np.atleast_1d(u)
 
 
+def _sympy():
+    import sympy
+    return sympy
+
+
+def _sym_msd():
+    return ck.symbolic_mass_spring_damper()
+
+
 def result():
     return ck.simulate(sys2(), T11, u=np.ones((11, 1)))
 
@@ -340,6 +349,10 @@ for _name, _fn in (("ctrb", ck.ctrb), ("ctrb_singular_values", ck.ctrb_singular_
                    ("symbolic_linear_flatness", ck.symbolic_linear_flatness)):
     matrix_cases(_name, "A", lambda A, _fn=_fn: _fn(A, B2), A2)
     matrix_cases(_name, "B", lambda B, _fn=_fn: _fn(A2, B), B2, empty=False)
+ok("symbolic_ctrb", "symbols", lambda: ck.symbolic_ctrb(*ck.symbolic_mass_spring_damper()))
+bad("symbolic_ctrb", "symbol times I", lambda: ck.symbolic_ctrb(_sym_msd()[0] * (1 + _sympy().I), _sym_msd()[1]), "A")
+ok("symbolic_linear_flatness", "symbols", lambda: ck.symbolic_linear_flatness(*ck.symbolic_mass_spring_damper()))
+bad("symbolic_linear_flatness", "two inputs", lambda: ck.symbolic_linear_flatness(A2, np.eye(2)), "B")
 bad("is_controllable", "tol negative", lambda: ck.is_controllable(A2, B2, tol=-1.0), "tol")
 bad("is_controllable", "tol NaN", lambda: ck.is_controllable(A2, B2, tol=np.nan), "tol")
 bad("ccf_transform", "uncontrollable", lambda: ck.ccf_transform(A_UNCTRL, B_UNCTRL), "B")
