@@ -281,19 +281,15 @@ def as_poles(poles, name: str = "poles", *, count: int) -> np.ndarray:
 def check_function_output(func: Callable, args: tuple, name: str, *, size: int, what: str) -> np.ndarray:
     """Call a user function once and explain a wrong return value before integrating.
 
-    `what` says what the value means ("dx/dt, one entry per state").
+    `what` says what the value means ("dx/dt, one entry per state"). Raises
+    `UserFunctionError` (a ValueError) naming `name` when the call raises or
+    returns None, text, complex numbers, NaN or inf (see `diagnostics.call_user`),
+    and ValueError when it returns the wrong number of values.
     """
-    try:
-        out = func(*args)
-    except Exception as err:  # the user's own bug: say where it happened
-        raise ValueError(
-            f"{name} raised {type(err).__name__} when called once as a check "
-            f"with arguments of shapes {[np.shape(a) for a in args]}: {err}"
-        ) from err
-    arr = np.asarray(out, dtype=float) if out is not None else None
-    if arr is None or arr.ndim > 1 and not (arr.ndim == 2 and 1 in arr.shape) or arr.size != size:
-        got = "None (did the function forget to return?)" if arr is None else f"shape {arr.shape}"
-        raise ValueError(
-            f"{name} returned {got}; expected {size} numbers ({what})."
-        )
+    from .diagnostics import call_user
+    if not callable(func):
+        raise ValueError(f"{name} must be a function: received {_describe(func)}; expected {what}.")
+    arr = call_user(func, args, name, where="when called once as a check")
+    if arr.ndim > 1 and not (arr.ndim == 2 and 1 in arr.shape) or arr.size != size:
+        raise ValueError(f"{name} returned shape {arr.shape}; expected {size} numbers ({what}).")
     return arr.ravel()
