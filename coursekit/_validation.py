@@ -23,6 +23,9 @@ __all__ = [
     "as_time_grid",
     "is_uniform",
     "as_poles",
+    "as_integer",
+    "as_text",
+    "time_grid",
     "check_function_output",
 ]
 
@@ -37,14 +40,37 @@ def _describe(value) -> str:
 
 
 def _is_complex(value) -> bool:
-    """True for complex numbers or arrays, even when their imaginary parts are zero."""
+    """True for complex numbers or arrays, even when their imaginary parts are zero.
+
+    Covers Python and numpy complex scalars and arrays, lists of them, and
+    sympy numbers or matrices whose entries are complex (e.g. ``1 + I``).
+    """
     if isinstance(value, (complex, np.complexfloating)):
         return True
-    if isinstance(value, np.ndarray):
-        return np.iscomplexobj(value)
-    if isinstance(value, (list, tuple)):
+    if isinstance(value, np.ndarray) and value.dtype.kind != "O":
+        return value.dtype.kind == "c"
+    try:
+        arr = np.asarray(value)
+    except (TypeError, ValueError):
+        return False
+    if arr.dtype.kind == "c":
+        return True
+    if arr.dtype.kind == "O":
+        # sympy numbers and matrices: complex when some entry has an imaginary part
         try:
-            return np.iscomplexobj(np.asarray(value))
+            return bool(np.any(np.asarray(value, dtype=complex).imag != 0))
+        except (TypeError, ValueError):
+            return False
+    return False
+
+
+def _is_text(value) -> bool:
+    """True for a string, or a list/array of strings ("1.0" is text, not a number)."""
+    if isinstance(value, (str, bytes)):
+        return True
+    if isinstance(value, (list, tuple, np.ndarray)):
+        try:
+            return np.asarray(value).dtype.kind in "US"
         except (TypeError, ValueError):
             return False
     return False
@@ -53,6 +79,11 @@ def _is_complex(value) -> bool:
 def _to_float_array(value, name: str) -> np.ndarray:
     if value is None:
         raise ValueError(f"{name} is missing: received None, expected a number or an array.")
+    if _is_text(value):
+        raise ValueError(
+            f"{name} must contain real numbers: received the text {value!r}; type the numbers "
+            "themselves, e.g. 0.5 or [[0, 1], [-2, -3]], without quotes."
+        )
     if _is_complex(value):
         raise ValueError(
             f"{name} must contain real numbers: received {_describe(value)} with complex "
@@ -167,6 +198,31 @@ def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False
     return x
 
 
+def as_integer(value, name: str, *, minimum: int | None = None, why: str = "") -> int:
+    """Return `value` as an int, checking it is a finite whole number (>= `minimum`)."""
+    if isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be a whole number: received {value!r}.")
+    k = int(as_scalar(value, name, integer=True))
+    if minimum is not None and k < minimum:
+        reason = f" ({why})" if why else ""
+        raise ValueError(f"{name} must be at least {minimum}: received {k}{reason}.")
+    return k
+
+
+def as_text(value, name: str, *, expected: str = "a string") -> str:
+    """Return `value` when it is a string, else raise naming `name`."""
+    if not isinstance(value, str):
+        raise ValueError(f"{name} must be {expected}: received {_describe(value)}.")
+    return value
+
+
+def time_grid(t_end, samples, *, t_end_name: str = "t_end") -> np.ndarray:
+    """``np.linspace(0, t_end, samples)`` after checking t_end > 0 and samples >= 2 (named)."""
+    t_end = as_scalar(t_end, t_end_name, positive=True)
+    samples = as_integer(samples, "samples", minimum=2, why="a time grid needs a start and an end")
+    return np.linspace(0.0, t_end, samples)
+
+
 def as_time_grid(t, name: str = "t", *, min_points: int = 2) -> np.ndarray:
     """Return `t` as a finite, strictly increasing 1-D time grid."""
     arr = as_vector(t, name)
@@ -225,19 +281,15 @@ def as_poles(poles, name: str = "poles", *, count: int) -> np.ndarray:
 def check_function_output(func: Callable, args: tuple, name: str, *, size: int, what: str) -> np.ndarray:
     """Call a user function once and explain a wrong return value before integrating.
 
-    `what` says what the value means ("dx/dt, one entry per state").
+    `what` says what the value means ("dx/dt, one entry per state"). Raises
+    `UserFunctionError` (a ValueError) naming `name` when the call raises or
+    returns None, text, complex numbers, NaN or inf (see `diagnostics.call_user`),
+    and ValueError when it returns the wrong number of values.
     """
-    try:
-        out = func(*args)
-    except Exception as err:  # the user's own bug: say where it happened
-        raise ValueError(
-            f"{name} raised {type(err).__name__} when called once as a check "
-            f"with arguments of shapes {[np.shape(a) for a in args]}: {err}"
-        ) from err
-    arr = np.asarray(out, dtype=float) if out is not None else None
-    if arr is None or arr.ndim > 1 and not (arr.ndim == 2 and 1 in arr.shape) or arr.size != size:
-        got = "None (did the function forget to return?)" if arr is None else f"shape {arr.shape}"
-        raise ValueError(
-            f"{name} returned {got}; expected {size} numbers ({what})."
-        )
+    from .diagnostics import call_user
+    if not callable(func):
+        raise ValueError(f"{name} must be a function: received {_describe(func)}; expected {what}.")
+    arr = call_user(func, args, name, where="when called once as a check")
+    if arr.ndim > 1 and not (arr.ndim == 2 and 1 in arr.shape) or arr.size != size:
+        raise ValueError(f"{name} returned shape {arr.shape}; expected {size} numbers ({what}).")
     return arr.ravel()

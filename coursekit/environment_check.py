@@ -108,7 +108,16 @@ def _labextension_dirs() -> list[Path]:
 
 
 def find_widget_frontend(dirs: list[Path] | None = None) -> str | None:
-    """Version of the installed ``@jupyter-widgets/jupyterlab-manager`` labextension, or None."""
+    """Version of the installed ``@jupyter-widgets/jupyterlab-manager`` labextension, or None.
+
+    `dirs` is a list of labextension directories to search (default: the
+    current environment's); a ValueError says so when it is anything else.
+    """
+    if dirs is not None and (isinstance(dirs, (str, bytes, Path)) or not isinstance(dirs, (list, tuple))
+                             or not all(isinstance(d, (str, Path)) for d in dirs)):
+        raise ValueError(f"dirs must be a list of directories (paths): received {dirs!r}; "
+                         "wrap a single directory in a list, [Path(...)].")
+    dirs = None if dirs is None else [Path(d) for d in dirs]
     for base in dirs if dirs is not None else _labextension_dirs():
         package = base.joinpath(*_MANAGER, "package.json")
         if package.is_file():

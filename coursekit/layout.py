@@ -54,6 +54,10 @@ def fit_margins(fig):
     lay it out, once to render it), and the first pass costs nearly as much
     as the second.
     """
+    from matplotlib.figure import Figure
+    if not isinstance(fig, Figure):
+        raise ValueError(f"fig must be a matplotlib Figure: received {type(fig).__name__}; "
+                         "pass the figure (fig, not an Axes), e.g. fig, ax = new_figure().")
     global _hook_class
     if _hook_class is None:
         _hook_class = _make_hook_class()

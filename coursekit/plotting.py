@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._validation import as_integer, as_matrix, as_text
 from .simulation import SimulationResult
 from .style import new_figure
 
@@ -56,7 +57,17 @@ def _check_result(result, argname: str = "result") -> SimulationResult:
 
 
 def _time_label(time_unit: str) -> str:
-    return f"time t [{time_unit}]"
+    unit = as_text(time_unit, "time_unit", expected="a unit such as 's' or 'min'")
+    return f"time t [{unit}]"
+
+
+def _state_index(value, name: str, n: int) -> int:
+    """A 0-based state index below n (x1 is index 0)."""
+    k = as_integer(value, name, minimum=0, why="indices count from 0: x1 is 0")
+    if k >= n:
+        raise ValueError(f"{name} is out of range: received {k}, but the system has n = {n} states "
+                         f"(indices 0 to {n - 1}; x1 is 0).")
+    return k
 
 
 def plot_response(result, which: str = "xu", *, state_names=None, output_names=None,
@@ -125,19 +136,27 @@ def _draw_signals(ax, t, data, names, units, *, discrete: bool) -> None:
 
 def _trajectory_list(trajectories, states) -> list[tuple[np.ndarray, bool]]:
     """(points, discrete) pairs: the two chosen state columns of each trajectory."""
+    if trajectories is None or isinstance(trajectories, (list, tuple)) and not trajectories:
+        raise ValueError("trajectories is empty: pass a SimulationResult, an (N, n) array of states, "
+                         "or a list of them.")
     items = trajectories if isinstance(trajectories, (list, tuple)) else [trajectories]
     out = []
     for k, item in enumerate(items):
         if isinstance(item, SimulationResult):
             data, discrete = item.x, item.system.is_discrete
         else:
-            data, discrete = np.asarray(item, dtype=float), True
-        if data.ndim != 2 or data.shape[1] <= max(states):
+            if np.ndim(item) != 2:
+                raise ValueError(
+                    f"trajectories[{k}] must be a SimulationResult or an array of shape (N, n): "
+                    f"received {type(item).__name__} with shape {np.shape(item)}.")
+            data, discrete = as_matrix(item, f"trajectories[{k}]"), True
+        picked = [as_integer(s, "states", minimum=0, why="indices count from 0: x1 is 0") for s in states]
+        if max(picked) >= data.shape[1]:
             raise ValueError(
-                f"trajectories[{k}] must be a SimulationResult or an array of shape (N, n) with "
-                f"n > {max(states)}: received shape {np.shape(data)}."
-            )
-        out.append((data[:, list(states)], discrete))
+                f"trajectories[{k}] must be an array with a column for each index in states="
+                f"{tuple(picked)}: received shape {data.shape}, whose state indices go up to "
+                f"{data.shape[1] - 1} (x1 is 0); choose states among them.")
+        out.append((data[:, picked], discrete))
     return out
 
 
@@ -166,8 +185,7 @@ def plot_state_plane(trajectories, *, states=(0, 1), labels=None, state_names=No
 
     Returns the figure.
     """
-    states = tuple(int(s) for s in states)
-    if len(states) != 2:
+    if np.ndim(states) != 1 or len(states) != 2:
         raise ValueError(f"states must name two state indices, e.g. (0, 1): received {states!r}.")
     items = _trajectory_list(trajectories, states)
     names = _names(state_names, "x", 2, "state_names") if state_names is not None else \
@@ -247,6 +265,12 @@ def plot_euler_comparison(exact, approximations, *, state: int = 0, state_name: 
     exact = _check_result(exact, "exact")
     items = approximations if isinstance(approximations, (list, tuple)) else [approximations]
     items = [_check_result(r, f"approximations[{k}]") for k, r in enumerate(items)]
+    for k, res in enumerate(items):
+        if not getattr(res.system, "is_discrete", False):
+            raise ValueError(
+                f"approximations[{k}] must be the simulation of a discrete-time system "
+                "(simulate(euler_discretize(sys, Ts), t_k)): received a continuous-time result.")
+    state = _state_index(state, "state", exact.x.shape[1])
     name = state_name or f"x{state + 1}"
     fig, (ax, ax_err) = new_figure(2, 1, figsize=figsize, sharex=True)
     ref = exact.x[:, state]

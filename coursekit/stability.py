@@ -65,14 +65,20 @@ def _as_pole_sets(poles) -> dict:
         items = [("poles", poles)]
     out = {}
     for label, values in items:
+        where = "poles" if label == "poles" and not isinstance(poles, dict) else f"poles[{label!r}]"
+        if values is None or isinstance(values, (str, bytes)):
+            raise ValueError(f"{where} must be a list of numbers: received {values!r}; "
+                             "e.g. np.linalg.eigvals(A + B @ K).")
         try:
             arr = np.atleast_1d(np.asarray(values, dtype=complex)).ravel()
         except (TypeError, ValueError):
             raise ValueError(
-                f"poles[{label!r}] must be a list of numbers: received {type(values).__name__}."
+                f"{where} must be a list of numbers: received {type(values).__name__}."
             ) from None
         if not np.all(np.isfinite(arr)):
-            raise ValueError(f"poles[{label!r}] contains NaN or infinite entries: {arr.tolist()!r}.")
+            raise ValueError(f"{where} contains NaN or infinite entries: {arr.tolist()!r}.")
+        if arr.size == 0:
+            raise ValueError(f"{where} is empty: pass at least one pole.")
         out[str(label)] = arr
     if not out:
         raise ValueError("poles is empty: pass an array of poles or a dict label -> poles.")
@@ -103,6 +109,10 @@ def plot_poles(poles, *, dt=None, ax=None, title: str | None = None):
         from .style import new_figure
         fig, ax = new_figure()
     else:
+        from matplotlib.axes import Axes
+        if not isinstance(ax, Axes):
+            raise ValueError(f"ax must be a matplotlib Axes: received {type(ax).__name__}; "
+                             "leave it out to draw a new figure.")
         fig = ax.figure
     everything = np.concatenate(list(sets.values()))
     reach = 1.25 * max(1.0, float(np.abs(everything.real).max(initial=0)),

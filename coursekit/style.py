@@ -7,6 +7,8 @@ a plot or an explorer makes it readable from the back of a lecture hall.
 
 from __future__ import annotations
 
+import numpy as np
+
 __all__ = ["lecture_mode", "is_lecture_mode", "new_figure", "LECTURE_STYLE"]
 
 #: matplotlib settings applied by ``lecture_mode(True)``.
@@ -62,7 +64,16 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplot_kw):
     it as the last expression of a notebook cell.
     """
     from matplotlib.figure import Figure
+    from ._validation import as_integer, as_vector
     from .layout import fit_margins
+    nrows = as_integer(nrows, "nrows", minimum=1, why="one row of axes at least")
+    ncols = as_integer(ncols, "ncols", minimum=1, why="one column of axes at least")
+    if figsize is not None:
+        size = as_vector(figsize, "figsize", size=2, why="(width, height) in inches")
+        if np.any(size <= 0):
+            raise ValueError(f"figsize must be positive: received {tuple(size)}; "
+                             "give (width, height) in inches, e.g. (8, 4).")
+        figsize = tuple(size)
     fig = fit_margins(Figure(figsize=figsize))
     axes = fig.subplots(nrows, ncols, squeeze=True, **subplot_kw)
     return fig, axes

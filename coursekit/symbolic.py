@@ -27,13 +27,32 @@ __all__ = [
 _SYSTEMS = ("pendulum", "two_wheeled", "car_like")
 
 
+def _check_real(expr, name: str) -> None:
+    """Raise unless the sympy expression is real where it is a number (symbols may stay)."""
+    import sympy as sp
+    if expr.has(sp.nan, sp.zoo, sp.oo, -sp.oo):
+        raise ValueError(f"{name} contains NaN or infinite entries: received {expr}; "
+                         "expected finite numbers or symbols.")
+    if expr.has(sp.I) or expr.is_number and expr.is_real is False:
+        raise ValueError(f"{name} must be real: received the complex entry {expr}; "
+                         "pass the real matrix (complex numbers are only accepted as poles).")
+
+
 def _sym_matrix(value, name: str):
     import sympy as sp
+    from ._validation import _is_complex, _is_text
+    if value is None or _is_text(value):
+        raise ValueError(f"{name} must be a matrix (nested list or sympy Matrix): received {value!r}.")
+    if _is_complex(value):
+        raise ValueError(f"{name} must be real: received complex entries; pass the real matrix "
+                         "(complex numbers are only accepted as poles).")
     try:
         M = sp.Matrix(value)
     except (TypeError, ValueError, sp.SympifyError) as err:
         raise ValueError(f"{name} must be a matrix (nested list or sympy Matrix): received "
                          f"{type(value).__name__} ({err}).") from None
+    for entry in M:
+        _check_real(entry, name)
     return M
 
 
@@ -200,6 +219,23 @@ def _planar(car: bool):
     return name, derivs, psi_x, psi_u
 
 
+def _sym_parameter(value, key: str):
+    """A parameter value for `symbolic_flat_maps`: a real number or a sympy expression."""
+    import sympy as sp
+    from ._validation import _is_complex, _is_text
+    if value is None or _is_text(value) or _is_complex(value):
+        raise ValueError(f"{key} must be a real number or a sympy expression: received {value!r}.")
+    try:
+        expr = sp.sympify(value)
+    except (sp.SympifyError, TypeError) as err:
+        raise ValueError(f"{key} must be a real number or a sympy expression: received "
+                         f"{type(value).__name__} ({err}).") from None
+    if not isinstance(expr, sp.Expr):
+        raise ValueError(f"{key} must be a real number or a sympy expression: received {value!r}.")
+    _check_real(expr, key)
+    return expr
+
+
 @lru_cache(maxsize=None)
 def _derivation(system: str):
     """The maps of `system`, derived once per session (sympy is slow); callers copy them."""
@@ -217,7 +253,7 @@ def symbolic_flat_maps(system: str, **params) -> SymbolicFlatMaps:
     ``L=2.5``) are substituted for the symbols of the same name; the others stay symbolic.
     """
     import sympy as sp
-    if system not in _SYSTEMS:
+    if not isinstance(system, str) or system not in _SYSTEMS:
         raise ValueError(f"system must be one of {_SYSTEMS}: received {system!r}.")
     name, derivs, psi_x, psi_u = _derivation(system)
     derivs = [list(row) for row in derivs]  # fresh containers: the cached ones stay untouched
@@ -226,5 +262,6 @@ def symbolic_flat_maps(system: str, **params) -> SymbolicFlatMaps:
     for key, value in params.items():
         if key not in known:
             raise ValueError(f"{key} is not a parameter of the {name}: expected one of {sorted(known)}.")
+        value = _sym_parameter(value, key)
         psi_x, psi_u = psi_x.subs(known[key], value), psi_u.subs(known[key], value)
     return SymbolicFlatMaps(name, derivs, sp.Matrix(psi_x), sp.Matrix(psi_u))

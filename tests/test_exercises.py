@@ -336,3 +336,68 @@ def test_feedback_flags_a_whole_sign_flip_and_a_transposed_column(expected):
     assert "opposite sign in every entry" in report.problems[-1]
     assert not matrix_feedback(expected.T, expected, "B", report)
     assert "transposed" in report.problems[-1] and "column (3 x 1)" in report.problems[-1]
+
+
+def _complex_right_real(a):
+    """The right answer plus a small imaginary part: its real part is exactly right."""
+    return np.asarray(a, dtype=float) + 1e-2j
+
+
+def _sympy_complex(a):
+    arr = np.atleast_2d(np.asarray(a, dtype=float))
+    return sp.Matrix(arr) + sp.I * sp.ones(*arr.shape)
+
+
+def _with_nan(a):
+    arr = np.array(a, dtype=float)
+    arr.flat[0] = np.nan
+    return arr
+
+
+#: how a bad answer is made from the right one, and what the feedback must say about it
+BAD_FORMS = {
+    "complex, right real part": (_complex_right_real, "complex"),
+    "complex, zero imaginary part": (lambda a: np.asarray(a, dtype=complex), "complex"),
+    "complex list": (lambda a: (np.asarray(a, dtype=float) + 0.5j).tolist(), "complex"),
+    "sympy complex": (_sympy_complex, "complex"),
+    "NaN entry": (_with_nan, "NaN"),
+    "text": (lambda a: str(np.asarray(a).tolist()), "not a string"),
+    "list of text": (lambda a: [str(v) for v in np.ravel(a)], "text"),
+    "None": (lambda a: None, "None"),
+    "stacked twice": (lambda a: np.stack([np.asarray(a, dtype=float)] * 2), "shape|dimensions|must list"),
+}
+
+
+@pytest.mark.parametrize("form", BAD_FORMS)
+@pytest.mark.parametrize("name", RIGHT)
+def test_bad_answer_gets_feedback_naming_the_problem(name, form, capsys):
+    """Each argument in turn made bad, the others right: "Not yet" and why, never "Correct" or an error."""
+    make, says = BAD_FORMS[form]
+    right = RIGHT[name]()
+    for i in range(len(right)):
+        args = list(right)
+        args[i] = make(right[i])
+        assert getattr(ex, name)(*args) is False, (i, args[i])
+        out = capsys.readouterr().out
+        assert out.startswith("Not yet") and re.search(says, out), out
+
+
+@pytest.mark.parametrize("call, says", [
+    (lambda: ex.check_kalman_decision(1 + 0j, False), "complex"),
+    (lambda: ex.check_kalman_decision(1.5, False), "whole number"),
+    (lambda: ex.check_kalman_decision(np.nan, False), "NaN"),
+    (lambda: ex.check_vehicle_observability(1 + 1j, False), "complex"),
+    (lambda: ex.check_vehicle_observability([1, 1], False), "whole number"),
+    (lambda: ex.check_stability([True, 1j, False, True]), "True or False"),
+    (lambda: ex.check_separation_poles([np.nan] * 4), "NaN"),
+    (lambda: ex.check_separation_poles("-1, -2, -3, -4"), "not a string"),
+    (lambda: ex.check_pendulum_f(lambda x, u: np.asarray(_pendulum_f(x, u)) + 1e-3j), "complex"),
+    (lambda: ex.check_pendulum_f(lambda x, u: [np.nan, 0.0]), "NaN"),
+    (lambda: ex.check_pendulum_f(lambda x, u: [x[1]]), "returned 1 numbers, expected 2"),
+    (lambda: ex.check_pendulum_f(lambda x, u: None), "forget the return"),
+    (lambda: ex.check_car_flatness(_car()[0] + 1e-3j, _car()[1]), "complex"),
+])
+def test_bad_answers_of_the_other_checks_get_feedback(call, says, capsys):
+    assert call() is False
+    out = capsys.readouterr().out
+    assert out.startswith("Not yet") and says in out, out

@@ -24,11 +24,14 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
+from .._validation import _is_complex
+
 __all__ = [
     "Report",
     "close",
     "read_matrix",
     "read_poles",
+    "read_numbers",
     "read_decision",
     "matrix_feedback",
     "poles_feedback",
@@ -75,8 +78,21 @@ def _is_sympy(value) -> bool:
     return type(value).__module__.split(".")[0] == "sympy"
 
 
+def _has_text(value) -> bool:
+    """True when some entry of `value` is a string ("1" is text, not the number 1)."""
+    try:
+        entries = np.ravel(np.asarray(value, dtype=object))
+    except (TypeError, ValueError):
+        return False
+    return any(isinstance(v, (str, bytes)) for v in entries)
+
+
 def _to_array(value, name: str, report: Report, *, dtype=float) -> np.ndarray | None:
-    """`value` as an array of numbers, or None with a message explaining why not."""
+    """`value` as an array of numbers, or None with a message explaining why not.
+
+    With the default real `dtype`, complex entries are reported (never dropped):
+    the answers of these exercises are real matrices.
+    """
     if value is None or value is Ellipsis:
         report.add(f"{name} is empty (None): replace the placeholder with your answer.")
         return None
@@ -85,6 +101,14 @@ def _to_array(value, name: str, report: Report, *, dtype=float) -> np.ndarray | 
         return None
     if callable(value) and not _is_sympy(value):
         report.add(f"{name} is a function: call it and pass its result (numbers), not the function.")
+        return None
+    if dtype is float and _is_complex(value):
+        report.add(f"{name} contains complex numbers: the answer is real. If the imaginary parts are "
+                   "rounding noise from a computation (e.g. np.linalg.eig), pass np.real(...) of it; "
+                   "otherwise recheck the computation.")
+        return None
+    if _has_text(value):
+        report.add(f"{name} contains text: type numbers, e.g. [[1, 2], [3, 4]], not strings.")
         return None
     try:
         arr = np.asarray(value, dtype=dtype)
@@ -206,7 +230,16 @@ def matrix_feedback(answer, expected, name: str, report: Report, *,
 
 def read_poles(value, name: str, count: int, report: Report) -> np.ndarray | None:
     """A list of `count` (possibly complex) numbers, or None with a message."""
-    arr = _to_array(value, name, report, dtype=complex)
+    return _read_list(value, name, count, report, dtype=complex)
+
+
+def read_numbers(value, name: str, count: int, report: Report) -> np.ndarray | None:
+    """A list of `count` real numbers (a single number for count 1), or None with a message."""
+    return _read_list(value, name, count, report, dtype=float)
+
+
+def _read_list(value, name: str, count: int, report: Report, *, dtype) -> np.ndarray | None:
+    arr = _to_array(value, name, report, dtype=dtype)
     if arr is None:
         return None
     arr = arr.ravel()
@@ -293,11 +326,13 @@ def call_student_function(func: Callable, args: tuple, name: str, size: int,
 def rank_decision_feedback(rank, decision, true_rank: int, n: int, report: Report, *,
                            word: str, rank_hint: str, decision_hint: str) -> None:
     """Check a rank and the yes/no decision "rank = n" of a Kalman criterion (W_c or W_o)."""
-    try:
-        if float(np.asarray(rank, dtype=float)) != true_rank:
-            report.add(f"the rank is off: {rank_hint}")
-    except (TypeError, ValueError):
-        report.add(f"rank must be a whole number: received {rank!r} (np.linalg.matrix_rank).")
+    inner = Report("rank")
+    value = _to_array(rank, "rank", inner)
+    if value is None or value.size != 1 or value.ravel()[0] != round(value.ravel()[0]):
+        shown = inner.problems[0] if inner.problems else f"received {rank!r}"
+        report.add(f"rank must be a whole number (np.linalg.matrix_rank): {shown}")
+    elif value.ravel()[0] != true_rank:
+        report.add(f"the rank is off: {rank_hint}")
     answer = read_decision(decision, word, report)
     if answer is not None and answer != (true_rank == n):
         report.add(f"the decision does not follow the criterion: {decision_hint}")

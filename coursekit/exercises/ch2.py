@@ -14,7 +14,7 @@ import numpy as np
 
 from ..controllability import ccf_transform, ctrb
 from ..flatness import car_like_flatness
-from ._feedback import Report, close, matrix_feedback, rank_decision_feedback, read_poles
+from ._feedback import Report, close, matrix_feedback, rank_decision_feedback, read_numbers
 
 __all__ = [
     "CTRB", "check_ctrb_matrix",
@@ -109,11 +109,11 @@ def check_car_flatness(v, delta) -> bool:
     report = Report("car-like robot")
     L = CAR["L"]
     (d1, d2), (dd1, dd2) = CAR["dF"], CAR["ddF"]
-    vv = read_poles(v, "v", 1, report)
-    dd = read_poles(delta, "delta", 1, report)
+    vv = read_numbers(v, "v", 1, report)
+    dd = read_numbers(delta, "delta", 1, report)
     if vv is None or dd is None:
         return report.show("")
-    vv, dd = float(vv[0].real), float(dd[0].real)
+    vv, dd = float(vv[0]), float(dd[0])
     sign = 1.0 if vv >= 0 else -1.0
     v_ok, delta_ok = _car_solution(sign)
     if not close(np.array(vv), np.array(v_ok)):

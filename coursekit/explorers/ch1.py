@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import models
-from .._validation import as_scalar
+from .._validation import as_integer, as_scalar, time_grid
 from ..realization import euler_discretize
 from ..simulation import simulate
 from ..systems import StateSpace
@@ -45,7 +45,8 @@ def euler_compute(Ts: float, example: str = "first order (1.12)", samples: int =
     ``stable`` (rho < 1), the stability limit ``Ts_max`` and the ``unit``.
     """
     Ts = as_scalar(Ts, "Ts", positive=True)
-    if example not in EULER_EXAMPLES:
+    samples = as_integer(samples, "samples", minimum=2, why="a curve needs two points at least")
+    if not isinstance(example, str) or example not in EULER_EXAMPLES:
         raise ValueError(f"example must be one of {list(EULER_EXAMPLES)}: received {example!r}.")
     sys, x0, t_end, unit = EULER_EXAMPLES[example]
     t = np.linspace(0.0, t_end, samples)
@@ -112,10 +113,11 @@ def msd_compute(m: float, d: float, k: float, experiment: str = "step", t_end: f
     m = as_scalar(m, "m", positive=True)
     k = as_scalar(k, "k", positive=True)
     d = as_scalar(d, "d")
-    if experiment not in ("step", "initial"):
+    if not isinstance(experiment, str) or experiment not in ("step", "initial"):
         raise ValueError(f"experiment must be 'step' or 'initial': received {experiment!r}.")
     sys = models.mass_spring_damper(m=m, d=d, k=k)
-    t = np.linspace(0.0, float(t_end), samples)
+    t = time_grid(t_end, samples)
+    samples = t.size
     if experiment == "step":
         res = simulate(sys, t, u=np.ones((samples, 1)))
     else:

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import models
-from .._validation import as_scalar
+from .._validation import as_scalar, as_series, as_time_grid, as_vector, time_grid
 from ..flatness import plan_robot
 from ..simulation import simulate
 from ..trajectory import feedforward, poly_trajectory
@@ -36,6 +36,9 @@ def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0
     T = as_scalar(T, "T", positive=True)
     target = as_scalar(target, "target")
     mass_error = as_scalar(mass_error, "mass_error")
+    if mass_error <= -100.0:
+        raise ValueError(f"mass_error must be above -100 %: received {mass_error!r} (the plant's mass "
+                         "would be zero or negative).")
     m, d, k = PLANNER_PLANT["m"], PLANNER_PLANT["d"], PLANNER_PLANT["k"]
     r = int(as_scalar(r, "r", positive=True, integer=True))
     if r < 2:
@@ -44,7 +47,7 @@ def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0
     zeros = [0.0] * (r - 1)
     traj = poly_trajectory(T, [0.0] + zeros, [target] + zeros)
     ud = feedforward([k / m, d / m], 1.0 / m, traj)
-    t = np.linspace(0.0, 2.0 * T, samples)
+    t = time_grid(2.0 * T, samples, t_end_name="T")
     # after T the plan holds y_d = target, so u_d = k * target
     u = np.where(t <= T, ud(np.minimum(t, T)), k * target)
     plant = models.mass_spring_damper(m=m * (1.0 + mass_error / 100.0), d=d, k=k)
@@ -108,7 +111,7 @@ def robot_planner_compute(x_T: float = 4.0, y_T: float = 2.0, heading_deg: float
     heading = np.deg2rad(as_scalar(heading_deg, "heading_deg"))
     T = as_scalar(T, "T", positive=True)
     speed = as_scalar(speed, "speed")
-    t = np.linspace(0.0, T, samples)
+    t = time_grid(T, samples, t_end_name="T")
     target = np.array([x_T, y_T, heading])
     empty = np.empty((0, 3))
     try:
@@ -139,6 +142,9 @@ def drive_robot(t, u, x0) -> np.ndarray:
     solver, stepping across the input's kinks) stays about 1e-8 away even at
     ``rtol=1e-13``.
     """
+    t = as_time_grid(t, "t")
+    u = as_series(u, "u", samples=t.size, channels=2, channels_why="u1 (speed) and u2 (turn rate)")
+    x0 = as_vector(x0, "x0", size=3, why="x1, x2, theta")
     h = np.diff(t)[:, None]
     nodes, weights = np.polynomial.legendre.leggauss(5)
     s, w = (nodes + 1.0) / 2.0, weights / 2.0          # on [0, 1]

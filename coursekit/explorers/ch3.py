@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import models
-from .._validation import as_scalar
+from .._validation import as_scalar, time_grid
 from ..controllers import PendulumLinearizingController, StateFeedback, integral_augment, integral_closed_loop
 from ..linearization import linearize
 from ..placement import place
@@ -60,10 +60,10 @@ def pole_placement_compute(wn: float = 2.0, zeta: float = 0.7, p3: float = -3.0,
     (eig(A + B K)), ``open_loop`` (eig A) and ``max_u`` = max |u|.
     """
     p3 = as_scalar(p3, "p3")
+    t = time_grid(t_end, samples)
     poles = np.concatenate([pair_poles(wn, zeta), [p3]])
     K = place(PLACEMENT_A, PLACEMENT_B, poles)
     A_cl = PLACEMENT_A + PLACEMENT_B @ K
-    t = np.linspace(0.0, as_scalar(t_end, "t_end", positive=True), int(samples))
     x = simulate(StateSpace(A_cl), t, x0=[1.0, 0.0, 0.0]).x
     u = x @ K[0]
     return dict(t=t, x=x, u=u, K=K, poles=poles, achieved=np.linalg.eigvals(A_cl),
@@ -135,6 +135,7 @@ def upright_pendulum_compute(theta0_deg: float = 30.0, pole: float = -2.0, u_max
     u_max = as_scalar(u_max, "u_max", positive=True)
     if pole >= 0:
         raise ValueError(f"pole must be negative (a stable closed loop): received {pole!r}.")
+    t = time_grid(t_end, samples)
     P = models.pendulum()
     x_eq, u_eq = np.array([np.pi, 0.0]), np.array([0.0])
     poles = [pole, pole - 1.0]
@@ -142,7 +143,6 @@ def upright_pendulum_compute(theta0_deg: float = 30.0, pole: float = -2.0, u_max
     K = place(A, B, poles)
     controllers = dict(linear=StateFeedback(K, x_eq, u_eq),
                        fl=PendulumLinearizingController(poles, theta_ref=np.pi))
-    t = np.linspace(0.0, as_scalar(t_end, "t_end", positive=True), int(samples))
     out = dict(t=t, K=K, theta0_deg=float(np.rad2deg(theta0)), u_max=u_max)
     laws = [_saturated(ctrl, u_max) for ctrl in controllers.values()]
 
@@ -211,11 +211,11 @@ def integral_action_compute(d: float = 1.0, integral_pole: float = -1.0, t_end: 
     integral_pole = as_scalar(integral_pole, "integral_pole")
     if integral_pole >= 0:
         raise ValueError(f"integral_pole must be negative: received {integral_pole!r}.")
+    t = time_grid(t_end, samples)
     A, B = INTEGRAL_A, INTEGRAL_B
     K = place(A, B, [-1.0, -2.0])
     A_E, B_E = integral_augment(A, B)
     K_E = place(A_E, B_E, [-1.0, -2.0, integral_pole])
-    t = np.linspace(0.0, as_scalar(t_end, "t_end", positive=True), int(samples))
     dist = np.where(t >= 1.0, d, 0.0)
     plain = simulate(StateSpace(A + B @ K, B), t, dist.reshape(-1, 1))
     loop = integral_closed_loop(A, B, K_E)

@@ -13,7 +13,7 @@ from functools import lru_cache
 import numpy as np
 
 from .. import models
-from .._validation import as_scalar
+from .._validation import as_integer, as_scalar, time_grid
 from ..kalman import kalman_gain, simulate_with_noise, white_noise
 from ..observability import place_observer
 from ..observers import observer_system
@@ -26,7 +26,7 @@ __all__ = ["KALMAN_TRUE_Q", "KALMAN_TRUE_R", "observer_noise_compute", "observer
 
 def _vehicle_setup(t_end: float, samples: int):
     sys = models.vehicle(m=1.0, d=1.0, sensor="gps")
-    t = np.linspace(0.0, t_end, samples)
+    t = time_grid(t_end, samples)
     # a traction force that speeds up, coasts and brakes [N]
     u = (np.sin(0.6 * t) + 0.5 * np.cos(1.7 * t))[:, None]
     return sys, t, u
@@ -52,6 +52,9 @@ def observer_noise_compute(speed: float, noise_std: float, *, seed: int = 0, t_e
     """
     speed = as_scalar(speed, "speed", positive=True)
     noise_std = as_scalar(noise_std, "noise_std")
+    if noise_std < 0:
+        raise ValueError(f"noise_std must be >= 0: received {noise_std!r} (a standard deviation in m).")
+    seed = as_integer(seed, "seed", minimum=0)
     sys, t, u = _vehicle_setup(t_end, samples)
     x0, xhat0 = np.array([1.0, 0.5]), np.zeros(2)
     L = place_observer(sys.A, sys.C, [-speed, -speed])
@@ -161,7 +164,10 @@ def kalman_tuning_compute(log10_q: float, log10_r: float, *, seed: int = 0, t_en
     """
     q = 10.0 ** as_scalar(log10_q, "log10_q")
     r = 10.0 ** as_scalar(log10_r, "log10_r")
-    sys, t, data, record, L_m, rms_m = _kalman_data(int(seed), float(t_end), int(samples))
+    # validated before the cache, so that the cache key is the checked value
+    t_end = float(time_grid(t_end, samples)[-1])
+    seed, samples = as_integer(seed, "seed", minimum=0), as_integer(samples, "samples")
+    sys, t, data, record, L_m, rms_m = _kalman_data(seed, t_end, samples)
     L, x_hat, rms = _kalman_run(sys, t, record, data.x, np.diag([0.0, q]), [[r]])
     return dict(t=t.copy(), x=data.x.copy(), x_hat=x_hat, y=data.y[:, 0].copy(), L=L, q=q, r=r,
                 poles=np.linalg.eigvals(sys.A - L @ sys.C), rms=rms, rms_matched=rms_m, L_matched=L_m)
