@@ -21,7 +21,7 @@ import numpy as np
 
 from ._validation import as_matrix, as_poles, as_square
 from .controllability import _ctrb, _rank
-from .placement import _gain, _PoleMatch, _warn_if_missed, poly_from_roots
+from .placement import _gain, _PoleMatch, _require_finite, _warn_if_missed, poly_from_roots
 
 __all__ = [
     "NotObservableError",
@@ -178,11 +178,14 @@ def place_observer_details(A, C, poles) -> ObserverDetails:
     p = poly_from_roots(poles)            # desired p(s) of the error dynamics
     L_ocf = (p - a).reshape(n, 1)         # (4.46): l_i = p_{i-1} - a_{i-1}
     L = V @ L_ocf                         # (4.60): L = V L~
-    _warn_if_missed(_PoleMatch(A - L @ C, poles), _OBSERVER)
+    _warn_if_missed(_PoleMatch(A - L @ C, poles, A), _OBSERVER)
     return ObserverDetails(T=T, V=V, A_ocf=A_ocf, C_ocf=C_ocf, a=a, p=p, L_ocf=L_ocf, L=L)
 
 
 _OBSERVER = {
+    "gain": "L",
+    "weak": ("some states show in y (the pair is nearly unobservable, or the poles are huge; see "
+             "obsv_singular_values)"),
     "what": "observer poles eig(A - L C) of the estimation error dynamics (4.27)",
     "advice": ("Try fewer or less clustered observer poles, poles closer to the open-loop ones, "
                "or rescale the states and time to similar magnitudes"),
@@ -225,5 +228,6 @@ def place_observer(A, C, poles) -> np.ndarray:
     # (4.84): L^T = place(A^T, C^T, P) in MATLAB's sign, i.e. L = -K^T in the course's
     K, _ = _gain(A.T, C.T, poles)
     L = -K.T
-    _warn_if_missed(_PoleMatch(A - L @ C, poles), _OBSERVER)
+    _require_finite(L, _OBSERVER)
+    _warn_if_missed(_PoleMatch(A - L @ C, poles, A), _OBSERVER)
     return L

@@ -339,3 +339,25 @@ def test_poly_from_roots_rejects_bad_poles(poles, message):
 def test_poly_from_roots_values():
     np.testing.assert_allclose(ck.poly_from_roots([-1 + 2j, -1 - 2j]), [5, 2])   # s^2 + 2 s + 5
     np.testing.assert_allclose(ck.poly_from_roots(-2), [2])
+
+
+# ------------------------------------------------------------------------------------------
+# Edge cases of the check: deadbeat designs, overflow
+
+def test_discrete_time_deadbeat_is_not_a_false_alarm():
+    # all poles at 0 (deadbeat, x(t+3) = 0) for a sampled triple integrator: the computed
+    # eigenvalues of the nilpotent A + B K scatter by ~eps^(1/3) ~ 1e-5, which the check judges
+    # against A's own speed (spectral radius 1), not against the requested 0
+    A = np.array([[1, 1, 0.5], [0, 1, 1], [0, 0, 1.0]])
+    B = np.array([[1 / 6], [0.5], [1.0]])
+    K = ck.place(A, B, [0, 0, 0])
+    np.testing.assert_allclose(np.linalg.matrix_power(A + B @ K, 3), 0, atol=1e-12)
+    L = ck.place_observer(A, [[1.0, 0, 0]], [0, 0, 0])
+    np.testing.assert_allclose(np.linalg.matrix_power(A - L @ np.array([[1.0, 0, 0]]), 3), 0, atol=1e-12)
+
+
+def test_an_overflowing_gain_is_an_error_not_a_nan():
+    with pytest.raises(ValueError, match=r"the gain K overflows double precision.*ctrb_singular"):
+        ck.place([[0, 1], [0, 0]], [[0], [1]], [-1e200, -1e200])
+    with pytest.raises(ValueError, match=r"the gain L overflows double precision.*obsv_singular"):
+        ck.place_observer([[0, 1], [0, 0]], [[1, 0]], [-1e200, -1e200])
