@@ -116,7 +116,8 @@ def place(A, B, poles) -> np.ndarray:
 
     Self-check: the closed-loop eigenvalues are matched to `poles` (optimal
     assignment) and must agree to 1e-6 of the pole scale (the largest
-    requested or achieved pole magnitude); a pole requested k times must have
+    requested or achieved pole magnitude, or A's spectral radius if larger,
+    so that deadbeat poles at 0 are judged fairly); a pole requested k times must have
     its k eigenvalues average to it to 1e-6 and each lie within (1e-6)^(1/k)
     of it, which is how far a relative perturbation of 1e-6 moves a k-fold
     eigenvalue. Otherwise an `AccuracyWarning` gives the largest error and the
