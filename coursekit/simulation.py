@@ -289,6 +289,9 @@ def _solver_options(rtol, atol, method, n: int, copies: int = 1) -> dict:
     so they are refused here with the option's name. `copies` repeats a
     per-state atol for the stacked state of `simulate_batch`.
     """
+    if (isinstance(rtol, float) and isinstance(atol, float) and _RTOL_MIN <= rtol < 1
+            and 0 < atol < math.inf and method in _METHODS):
+        return dict(rtol=rtol, atol=atol, method=method)   # the usual case, without array checks
     rtol = as_scalar(rtol, "rtol")
     if not _RTOL_MIN <= rtol < 1:
         raise ValueError(
@@ -487,6 +490,9 @@ def _growth(sys, feedback: bool = False) -> str:
 
 def _check_finite(sys, t: np.ndarray, x: np.ndarray, *, feedback: bool = False) -> None:
     """Raise `_overflow` at the first sample where x (N, ...) is not finite."""
+    with np.errstate(over="ignore"):   # a sum of large finite entries may overflow: settled below
+        if math.isfinite(x.sum()):     # the cheap screen of `_screen`
+            return
     bad = ~np.isfinite(x.reshape(t.size, -1)).all(axis=1)
     if bad.any():
         k = max(int(np.argmax(bad)), 1)
