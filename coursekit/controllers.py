@@ -23,7 +23,8 @@ from typing import Callable
 import numpy as np
 
 from ._validation import as_matrix, as_scalar, as_square, as_vector
-from .systems import NonlinearSystem, StateSpace
+from .diagnostics import UserFunctionError
+from .systems import NonlinearSystem, StateSpace, _checked_call, _float_array
 
 __all__ = [
     "StateFeedback",
@@ -42,6 +43,23 @@ def _fmt(v) -> str:
 
 def _gain(K, name: str = "K") -> np.ndarray:
     return as_matrix(K, name, rows=1 if np.ndim(K) == 1 else None)
+
+
+def _states(x, n: int, name: str = "x") -> np.ndarray:
+    """x as one state (n,) or a batch (n, k) of states as columns; other shapes raise
+    ValueError (a row (1, n) or a wrong length would broadcast into a wrong answer)."""
+    x = np.asarray(x)
+    if x.dtype.kind != "f":
+        x = _float_array(x, name)
+    if x.ndim not in (1, 2) or x.shape[0] != n:
+        raise ValueError(f"{name} has shape {x.shape}: expected ({n},), one entry per state, "
+                         f"or ({n}, k) for a batch of k states as columns.")
+    return x
+
+
+def _column(v: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """v (one entry per row) shaped to broadcast against x, one state or a batch."""
+    return v if x.ndim == 1 else v[:, None]
 
 
 class StateFeedback:
@@ -63,9 +81,9 @@ class StateFeedback:
             u_eq, "u_eq", size=m, why=f"one per input, since K is {m}x{n}")
 
     def __call__(self, t, x) -> np.ndarray:
-        x = np.asarray(x, dtype=float)
+        # x: one state (n,), or a batch (n, k) as `simulate_batch` passes it
+        x = _states(x, self.K.shape[1])
         if x.ndim == 2:
-            # a batch (n, k) of states, one per column, as `simulate_batch` passes it
             return self.K @ (x - self.x_eq[:, None]) + self.u_eq[:, None]
         # (3.92): u = K (x - x*) + u*
         return self.K @ (x - self.x_eq) + self.u_eq
@@ -75,15 +93,26 @@ class StateFeedback:
 
 
 def _trajectory(func, name: str, size: int, what: str) -> Callable:
+    """func(t) as `size` finite numbers, checked at t = 0 and at every call: an
+    exception, NaN/inf or a wrong size raises `UserFunctionError` naming `name` and t."""
     if not callable(func):
         raise ValueError(f"{name} must be a function of time t returning {what}: "
                          f"received {type(func).__name__}.")
 
+    def explain(t, err=None):
+        _checked_call(func, (t,), name, size=size, what=what, where=f"at t = {t:.6g}")
+        raise UserFunctionError(f"{name} failed at t = {t:.6g}, but returned {size} finite numbers "
+                                "when called again: does it change between calls?") from err
+
     def wrapped(t):
-        return np.ravel(np.asarray(func(t), dtype=float))
-    value = wrapped(0.0)
-    if value.size != size:
-        raise ValueError(f"{name}(0) returned {value.size} numbers; expected {size} ({what}).")
+        try:
+            value = np.ravel(np.asarray(func(t), dtype=float))
+            if value.size == size and np.isfinite(value).all():
+                return value
+        except Exception as err:
+            explain(t, err)
+        explain(t)
+    wrapped(0.0)
     return wrapped
 
 
@@ -94,6 +123,11 @@ class TrackingController:
     input that produces it (m numbers), with x_d' = A x_d + B u_d (3.101).
     The feedback term corrects the deviation Delta x = x - x_d, whose dynamics
     are A + B K (3.103).
+
+    Call it as ``controller(t, x)`` with t a number and x one state (n,) or a
+    batch (n, k) of states (returning (m, k)). x_d and u_d are checked at
+    t = 0 and at every call: an exception, NaN/inf or a wrong number of
+    values raises `UserFunctionError` naming the function and the time.
     """
 
     def __init__(self, K, x_d: Callable, u_d: Callable):
@@ -103,8 +137,10 @@ class TrackingController:
         self.u_d = _trajectory(u_d, "u_d", m, f"the open-loop input, {m} numbers")
 
     def __call__(self, t, x) -> np.ndarray:
+        x = _states(x, self.K.shape[1])
+        t = as_scalar(t, "t")
         # (3.104): u = K (x - x_d(t)) + u_d(t)
-        return self.K @ (np.asarray(x, dtype=float) - self.x_d(t)) + self.u_d(t)
+        return self.K @ (x - _column(self.x_d(t), x)) + _column(self.u_d(t), x)
 
     def __repr__(self) -> str:
         return f"TrackingController(K={_fmt(self.K)})"
@@ -178,8 +214,10 @@ class IntegralFeedback:
         self.K_I, self.K = self.K_E[:, :k], self.K_E[:, k:]
 
     def __call__(self, t, x_E) -> np.ndarray:
+        # x_E: one augmented state (N,) or a batch (N, k)
+        x_E = _states(x_E, self.K_E.shape[1], "x_E")
         # (3.110)/(3.125): u = K x + K_I * integral
-        return self.K_E @ np.asarray(x_E, dtype=float)
+        return self.K_E @ x_E
 
     def __repr__(self) -> str:
         return f"IntegralFeedback(K_I={_fmt(self.K_I)}, K={_fmt(self.K)})"
@@ -205,12 +243,10 @@ def with_integrators(sys, C=None, r=None, *, integrators: int = 1) -> NonlinearS
     k = q * p
 
     def f(x_E, u):
+        # x_E: one state or a batch (n + k, ...) of them as columns
         xi, x = x_E[:k], x_E[k:]
-        dxi = np.empty(k)
-        dxi[:k - p] = xi[p:]
-        # (3.127): the integrator integrates the error C x - r
-        dxi[k - p:] = C @ x - r
-        return np.concatenate([dxi, sys.f(x, u)])
+        # xi_{j+1}' = xi_j, and (3.127): the integrator integrates the error C x - r
+        return np.concatenate([xi[p:], C @ x - _column(r, x), sys.f(x, u)])
 
     name = f"{sys.name or 'system'} with {q} integrator(s)"
     return NonlinearSystem(f, n=n + k, m=sys.m, name=name)
@@ -265,7 +301,7 @@ class PendulumLinearizingController:
 
     def __call__(self, t, x) -> np.ndarray:
         # x1, x2 are numbers, or rows of a batch (2, k) of states as `simulate_batch` passes it
-        x1, x2 = np.asarray(x[0], dtype=float), np.asarray(x[1], dtype=float)
+        x1, x2 = _states(x, 2)
         # (3.147): v = -p0 x1 - p1 x2, measured from the target angle
         v = -self.p0 * (x1 - self.theta_ref) - self.p1 * x2
         # (3.153): u = m g l sin(x1) + m l^2 v (+ the damping term)

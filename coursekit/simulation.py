@@ -13,19 +13,51 @@ Three paths, chosen from the system and the input:
 * everything else (nonlinear systems, inputs given as a function `u(t, x)`):
   `scipy.integrate.solve_ivp` with the DOP853 method and tight tolerances
   (rtol=1e-9, atol=1e-12 by default).
+
+Nothing hangs and nothing fails silently. The solver options are checked
+before anything runs. The user's functions -- the model f, the output map h,
+an input u(t, x) -- are called once at the start and then watched at every
+evaluation (a plain call and one finiteness test, so the guard costs little);
+the first exception or NaN/inf stops the simulation with a `UserFunctionError`
+that names the function, the time and the state. A state that leaves the
+float range (an unstable system simulated for too long, a finite escape
+time), and an ODE solver that gives up, raise a `SimulationError` saying when
+and why, instead of returning a curve that turns into inf/NaN and vanishes
+from the plot.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_series, as_time_grid, as_vector, check_function_output, is_uniform
-from .systems import NonlinearSystem, StateSpace
+from ._validation import as_matrix, as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
+from .diagnostics import UserFunctionError, call_user
+from .systems import NonlinearSystem, StateSpace, _checked_call
 
-__all__ = ["simulate", "simulate_batch", "SimulationResult", "lti_step_matrices"]
+__all__ = ["simulate", "simulate_batch", "SimulationResult", "SimulationError", "lti_step_matrices"]
+
+# the method names scipy.integrate.solve_ivp accepts
+_METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
+# solve_ivp raises a smaller rtol to 100 eps (with only a warning); coursekit refuses it instead
+_RTOL_MIN = 100 * np.finfo(float).eps
+# beyond sqrt(largest float) ~ 1.3e154 the square of a state entry overflows: any model with
+# a quadratic term returns inf there, which is the state's growth, not a bug in the model
+_HUGE = float(np.sqrt(np.finfo(float).max))
+
+
+class SimulationError(ValueError, RuntimeError):
+    """The simulation cannot reach the end of the time grid.
+
+    Raised when the state overflows the float range (about 1.8e308: an
+    unstable system simulated for too long, or a solution with a finite
+    escape time) and when the ODE solver gives up. The message says at
+    which time, why, and what to try. It is both a ValueError and a
+    RuntimeError, so either catches it.
+    """
 
 
 @dataclass(repr=False)
@@ -78,11 +110,33 @@ def simulate(sys, t, u=None, x0=None, *, rtol: float = 1e-9, atol: float = 1e-12
     rtol, atol, method :
         Tolerances and method of `scipy.integrate.solve_ivp`, used for
         nonlinear systems and callable inputs only; the exact LTI path
-        ignores them. Pick ``method="LSODA"`` or ``"Radau"`` for a stiff system.
+        ignores them, but they are checked on every path. `rtol` is a number
+        in [2.2e-14, 1) (100 machine epsilons is the smallest solve_ivp
+        works with), `atol` a number > 0 or one per state (in the states'
+        units), `method` one of "RK45", "RK23", "DOP853", "Radau", "BDF",
+        "LSODA" or an `OdeSolver` subclass. Pick "LSODA" or "Radau" for a
+        stiff system.
 
     Returns
     -------
     SimulationResult with ``t, x, y, u`` (time-major) and ``.plot()``.
+    Every number in it is finite.
+
+    Raises
+    ------
+    ValueError
+        A bad argument, named: a shape, NaN, a tolerance or a method.
+    UserFunctionError (a ValueError)
+        f, h or u raised, returned NaN/inf or the wrong number of values,
+        at the start or at any later time; the message names the function,
+        the time t and the state x.
+    SimulationError (a ValueError and a RuntimeError)
+        The state left the float range, or the ODE solver stopped early; the
+        message gives the time and, for a StateSpace, the growth rate from the
+        eigenvalues of A (section 3.2.2). This is an error, not a warning: a
+        result holding inf/NaN plots as a curve that silently stops, and
+        whatever is computed from it is meaningless; the error says up to
+        which time the simulation is meaningful.
     """
     if not isinstance(sys, (StateSpace, NonlinearSystem)):
         raise ValueError(
@@ -92,18 +146,24 @@ def simulate(sys, t, u=None, x0=None, *, rtol: float = 1e-9, atol: float = 1e-12
     t = as_time_grid(t, "t", min_points=1 if sys.is_discrete else 2)
     x0 = np.zeros(sys.n) if x0 is None else as_vector(
         x0, "x0", size=sys.n, why=f"one per state of the {sys.n}-state system")
-    u_arr, u_fun = _input(sys, t, u, x0)
+    options = _solver_options(rtol, atol, method, sys.n)
+    u_arr, u_fun, u_user = _input(sys, t, u, x0)
+    model = _Model(sys, u_fun, u_user)
+    if isinstance(sys, NonlinearSystem):
+        sys.check(x0, u_fun(t[0], x0) if u_fun else u_arr[0], where=_where(t[0], x0))
     if sys.is_discrete:
         _check_discrete_grid(t, sys.dt)
-        x, u_arr = _iterate(sys, t, x0, u_arr, u_fun)
-    elif isinstance(sys, StateSpace) and u_fun is None:
-        x = _lti_exact(sys, t, x0, u_arr)
-    else:
-        if isinstance(sys, NonlinearSystem):
-            sys.check(x0, u_fun(t[0], x0))
-        x = _integrate(sys, t, x0, u_fun, rtol=rtol, atol=atol, method=method)
-        u_arr = np.array([u_fun(tk, xk) for tk, xk in zip(t, x)]).reshape(t.size, sys.m)
-    return SimulationResult(t=t, x=x, y=_outputs(sys, x, u_arr), u=u_arr, system=sys)
+    # numpy's overflow warnings would only precede the SimulationError that explains them
+    with np.errstate(over="ignore"):
+        if sys.is_discrete:
+            x, u_arr = _iterate(model, t, x0, u_arr)
+        elif isinstance(sys, StateSpace) and u_fun is None:
+            x = _lti_exact(sys, t, x0, u_arr)
+        else:
+            x = _integrate(model, t, x0, options)
+            u_arr = _inputs_on_grid(model, t, x)
+    _check_finite(sys, t, x, feedback=u_user is not None)
+    return SimulationResult(t=t, x=x, y=_outputs(sys, t, x, u_arr), u=u_arr, system=sys)
 
 
 def simulate_batch(sys, t, x0s, u=None, *, rtol: float = 1e-9, atol: float = 1e-12,
@@ -127,36 +187,72 @@ def simulate_batch(sys, t, x0s, u=None, *, rtol: float = 1e-9, atol: float = 1e-
     u : callable, optional
         ``u(t, X)`` with X of shape (n, k) returning (m, k), e.g.
         ``lambda t, X: K @ X`` for state feedback; default zero input.
+    rtol, atol, method :
+        As in `simulate` (atol may give one value per state).
 
     Returns
     -------
     x : (N, k, n) array -- ``x[:, j]`` is the trajectory from ``x0s[j]``.
+
+    Raises the errors of `simulate`, with the same guards: f and u are
+    checked at the start (each initial state on its own, then the batch)
+    and at every evaluation; a failure names the function, the time and
+    the trajectory.
     """
     if not isinstance(sys, (StateSpace, NonlinearSystem)) or sys.is_discrete:
         raise ValueError("sys must be a continuous-time StateSpace or NonlinearSystem for simulate_batch.")
     t = as_time_grid(t, "t")
     X0 = as_matrix(x0s, "x0s", cols=sys.n, cols_why="one column per state")
     n, k, m = sys.n, X0.shape[0], sys.m
-    u_fun = (lambda tk, X: np.zeros((m, X.shape[1]))) if u is None else u
-    _check_batch(sys, t[0], X0.T, u_fun)
+    options = _solver_options(rtol, atol, method, n, copies=k)
+    if u is not None and not callable(u):
+        raise ValueError(f"u must be a function u(t, X) returning ({m}, k) inputs for the batch X "
+                         f"(n, k) of states, or None: received {type(u).__name__}.")
+    u_batch = (lambda tk, X: np.zeros((m, X.shape[1]))) if u is None else u
+    model = _Model(sys, None, u_batch)
+    _check_batch(model, t[0], X0.T)
+    with np.errstate(over="ignore"):   # the SimulationError explains an overflow
+        x = _integrate_batch(model, t, X0.T, options)
+    _check_finite(sys, t, x.reshape(t.size, n * k), feedback=u is not None)
+    return x.reshape(t.size, n, k).transpose(0, 2, 1)
+
+
+def _integrate_batch(model, t: np.ndarray, X0: np.ndarray, options: dict) -> np.ndarray:
+    """The stacked ODE X' = f(X, u(t, X)), guarded like `_integrate`; (N, n k) on the grid t."""
+    from scipy.integrate import solve_ivp
+    (n, k), m = X0.shape, model.sys.m
+    f, u, last = model.f, model.u_user, [t[0], X0]
 
     def rhs(tk, flat):
-        X = flat.reshape(n, k)
-        return np.asarray(sys.f(X, np.asarray(u_fun(tk, X), float).reshape(m, k)), float).ravel()
+        X = last[1] = flat.reshape(n, k)
+        last[0] = tk
+        try:
+            F = np.asarray(f(X, np.asarray(u(tk, X), dtype=float).reshape(m, k)), dtype=float)
+            if F.size == n * k and _screen(F):
+                return F.reshape(-1)
+        except Exception as err:
+            model.fail_batch(tk, X, err)
+        if F.size == n * k and np.isfinite(F).all():   # the screen's sum overflowed
+            return F.reshape(-1)
+        model.fail_batch(tk, X)
 
-    from scipy.integrate import solve_ivp
-    sol = solve_ivp(rhs, (t[0], t[-1]), X0.T.ravel(), t_eval=t, method=method, rtol=rtol, atol=atol)
-    if not sol.success or sol.y.shape[1] != t.size:
-        raise RuntimeError(f"the ODE solver stopped early: {sol.message}")
-    return sol.y.T.reshape(t.size, n, k).transpose(0, 2, 1)
+    sol = solve_ivp(rhs, (t[0], t[-1]), X0.ravel(), t_eval=t, **options)
+    if not sol.success or np.size(sol.t) != t.size:
+        raise _solver_failure(model.sys, sol, last)
+    return sol.y.T
 
 
-def _check_batch(sys, t0: float, X: np.ndarray, u_fun) -> None:
-    """Check once that f and u accept a batch and agree with column-by-column calls."""
-    U = np.asarray(u_fun(t0, X), dtype=float)
-    if U.shape != (sys.m, X.shape[1]):
-        raise ValueError(f"u returned shape {U.shape} for a batch X of shape {X.shape}; "
-                         f"expected ({sys.m}, {X.shape[1]}), one column per initial state.")
+def _check_batch(model, t0: float, X: np.ndarray) -> None:
+    """Check once that f and u accept a batch and agree with column-by-column calls.
+
+    Each initial state is checked on its own first (`NonlinearSystem.check`:
+    an exception, NaN/inf or a wrong shape named with x0s[j]), then the batch.
+    """
+    sys = model.sys
+    U = _batch_input(model.u_user, t0, X, sys.m)
+    if isinstance(sys, NonlinearSystem):
+        for j in range(X.shape[1]):
+            sys.check(X[:, j], U[:, j], where=f"{_where(t0, X[:, j])} (x0s[{j}])")
     try:
         F = np.asarray(sys.f(X, U), dtype=float)
     except Exception as err:
@@ -168,6 +264,15 @@ def _check_batch(sys, t0: float, X: np.ndarray, u_fun) -> None:
                          "use simulate for one initial state at a time.")
 
 
+def _batch_input(u, tk: float, X: np.ndarray, m: int) -> np.ndarray:
+    """u(t, X) for a batch X (n, k), checked: finite and of shape (m, k)."""
+    U = call_user(u, (tk, X), "u", where=f"at t = {tk:.6g} on the batch X of shape {X.shape}")
+    if U.shape != (m, X.shape[1]):
+        raise ValueError(f"u returned shape {U.shape} for a batch X of shape {X.shape}; "
+                         f"expected ({m}, {X.shape[1]}), one column per initial state.")
+    return U
+
+
 def _agrees_column_by_column(fun, X: np.ndarray, U: np.ndarray, batch: np.ndarray) -> bool:
     """True when `batch`, fun's answer for the states X and inputs U as columns, holds
     fun(X[:, j], U[:, j]) in column j for every j (within 1e-12)."""
@@ -176,26 +281,269 @@ def _agrees_column_by_column(fun, X: np.ndarray, U: np.ndarray, batch: np.ndarra
                                                      rtol=1e-12, atol=1e-12)
 
 
+def _solver_options(rtol, atol, method, n: int, copies: int = 1) -> dict:
+    """rtol, atol and method for solve_ivp, checked before anything runs.
+
+    A NaN or zero tolerance makes solve_ivp shrink its step for ever (with
+    atol = 0 a state that passes through zero asks for unreachable accuracy),
+    so they are refused here with the option's name. `copies` repeats a
+    per-state atol for the stacked state of `simulate_batch`.
+    """
+    if (isinstance(rtol, float) and isinstance(atol, float) and _RTOL_MIN <= rtol < 1
+            and 0 < atol < math.inf and method in _METHODS):
+        return dict(rtol=rtol, atol=atol, method=method)   # the usual case, without array checks
+    rtol = as_scalar(rtol, "rtol")
+    if not _RTOL_MIN <= rtol < 1:
+        raise ValueError(
+            f"rtol must be between {_RTOL_MIN:.2g} (100 machine epsilons, the smallest relative "
+            f"tolerance solve_ivp works with) and 1: received {rtol!r}; the default 1e-9 suits "
+            "most systems."
+        )
+    atol = as_vector(atol, "atol")
+    if atol.size not in (1, n):
+        raise ValueError(f"atol must be one number or one per state ({n}): received {atol.size} entries.")
+    if not np.all(atol > 0):
+        raise ValueError(
+            f"atol must be > 0: received {np.array2string(atol)}. With atol = 0 a state passing "
+            "through zero asks for an accuracy the solver cannot reach; use a small positive value "
+            "in the state's units (the default is 1e-12), one per state if their scales differ."
+        )
+    atol = float(atol[0]) if atol.size == 1 else np.repeat(atol, copies)
+    return dict(rtol=rtol, atol=atol, method=_method(method))
+
+
+def _method(method):
+    """`method` if solve_ivp knows it (a name of `_METHODS` or an OdeSolver subclass)."""
+    if isinstance(method, str) and method in _METHODS:
+        return method
+    if isinstance(method, type):
+        from scipy.integrate import OdeSolver
+        if issubclass(method, OdeSolver):
+            return method
+    close = [name for name in _METHODS if isinstance(method, str) and name.lower() == method.lower()]
+    hint = f" (did you mean {close[0]!r}? the names are case-sensitive)" if close else ""
+    raise ValueError(
+        f"method must be one of {', '.join(map(repr, _METHODS))} (the methods of "
+        f"scipy.integrate.solve_ivp) or an OdeSolver subclass: received {method!r}{hint}."
+    )
+
+
+def _where(tk, xk) -> str:
+    """'at t = 0.5, x = [1. 2.]': where a user function was called, for error messages."""
+    return f"at t = {float(tk):.6g}, x = {np.array2string(np.asarray(xk), precision=6)}"
+
+
+class _Model:
+    """x' = f(x, u(t, x)) (or x(t+1) = ...) as `simulate` evaluates it, failures explained.
+
+    The hot paths (`input`, `step`, the solver's right-hand sides in
+    `_integrate` and `_integrate_batch`) make plain calls and one finiteness
+    test. On the first exception, NaN/inf or wrong size, `fail` repeats the
+    calls through `call_user` and raises a `UserFunctionError` naming the
+    function, the time and the state -- or a `SimulationError` when the state
+    itself has left the float range.
+
+    `u_fun(t, x)` is the input as the simulation uses it (the user's function
+    with its value flattened, an interpolation or zero), `u_user` the user's
+    own function (None for an array input).
+    """
+
+    def __init__(self, sys, u_fun, u_user=None):
+        self.sys, self.u_fun, self.u_user = sys, u_fun, u_user
+        self.f = _raw_field(sys)
+
+    def input(self, tk, xk) -> np.ndarray:
+        """u(t, x), finite."""
+        try:
+            uk = self.u_fun(tk, xk)
+            if _screen(uk):
+                return uk
+        except Exception as err:
+            self.fail(tk, xk, err)
+        return self.settle(tk, xk, uk, uk.size)
+
+    def step(self, tk, xk, uk) -> np.ndarray:
+        """f(x, u): dx/dt or x(t+1), n finite numbers."""
+        try:
+            value = self.f(xk, uk)
+            if isinstance(value, np.ndarray) and value.shape == (self.sys.n,) and _screen(value):
+                return value
+        except Exception as err:
+            self.fail(tk, xk, err, uk=uk)
+        return self.settle(tk, xk, value, self.sys.n, uk=uk)
+
+    def settle(self, tk, xk, value, size: int, *, uk=None) -> np.ndarray:
+        """The slow path after the fast test failed: `value` as a flat float array when
+        it is `size` finite numbers (a list, an (n, 1) answer, a sum that overflowed),
+        else `fail`."""
+        try:
+            flat = np.asarray(value, dtype=float).reshape(-1)
+            if flat.size == size and np.isfinite(flat).all():
+                return flat
+        except (TypeError, ValueError) as err:
+            self.fail(tk, xk, err, uk=uk)
+        self.fail(tk, xk, uk=uk)
+
+    def fail(self, tk, xk, err=None, *, uk=None):
+        """Raise the error that explains why u or f failed at time tk and state xk
+        (`uk`: the input there when it is a sample of an array, not a function)."""
+        where = _where(tk, xk)
+        self._check_range(tk, xk)
+        if self.u_fun is not None:
+            uk = self._checked_input(tk, xk, where)
+        self._check_state(tk, xk, uk, where)
+        raise UserFunctionError(
+            f"the model failed {where}, but u and f returned finite values when called again "
+            "there: do they change between calls (a counter, random numbers)?") from err
+
+    def _checked_input(self, tk, xk, where: str) -> np.ndarray:
+        """u(t, x) through `call_user` and the shape check, for the user's function."""
+        if self.u_user is None:
+            return self.u_fun(tk, xk)
+        m = self.sys.m
+        return _checked_call(self.u_user, (tk, xk), "u", size=m, where=where,
+                             what=f"the {m} input(s) at time t and state x")
+
+    def fail_batch(self, tk, X, err=None):
+        """`fail` for a batch X (n, k): u once on the batch, then f trajectory by trajectory."""
+        self._check_range(tk, X)
+        U = _batch_input(self.u_user, tk, X, self.sys.m)
+        for j in range(X.shape[1]):
+            self._check_state(tk, X[:, j], U[:, j], f"{_where(tk, X[:, j])} (trajectory {j}, from x0s[{j}])")
+        raise UserFunctionError(
+            f"the model failed at t = {tk:.6g} on the batch of states, but u and f returned finite "
+            "values when called again there: do they change between calls?") from err
+
+    def _check_state(self, tk, xk, uk, where: str) -> None:
+        """Return if f(xk, uk) gives n finite numbers; else raise: SimulationError when
+        the state has left the float range, the error of `NonlinearSystem.check` otherwise."""
+        try:
+            value = np.asarray(self.f(xk, uk), dtype=float)
+            if value.size == self.sys.n and np.isfinite(value).all():
+                return
+        except Exception:
+            pass
+        self._check_range(tk, xk)
+        if isinstance(self.sys, StateSpace):
+            raise _overflow(self.sys, f"A x + B u left it {where}", feedback=self.u_user is not None)
+        self.sys.check(xk, uk, where=where)
+
+    def _check_range(self, tk, xk) -> None:
+        """Raise `_overflow` when the state is not finite or beyond `_HUGE`: then the
+        failure is the state's growth, whatever u or f make of such a state."""
+        if _out_of_range(xk):
+            raise _overflow(self.sys, f"the state reached {np.array2string(np.asarray(xk), precision=3)} "
+                            f"at t = {tk:.6g}", feedback=self.u_user is not None)
+
+
+def _raw_field(sys) -> Callable:
+    """f(x, u) for the hot loops, without the argument checks and the conversion of
+    `sys.f` (the solver's x and the checked u have the right shapes by construction;
+    the callers convert and check the value)."""
+    if isinstance(sys, StateSpace):
+        A, B = sys.A, sys.B
+        return lambda x, u: A @ x + B @ u
+    return sys._f
+
+
+def _out_of_range(x) -> bool:
+    """True when x has inf/NaN entries or entries beyond `_HUGE`."""
+    return not np.isfinite(x).all() or np.abs(x).max(initial=0.0) > _HUGE
+
+
+def _screen(a: np.ndarray) -> bool:
+    """Fast test that a holds no NaN/inf: its sum is finite (a few times cheaper than
+    ``np.isfinite(a).all()`` on the small arrays of a right-hand side). A sum can
+    also overflow from finite entries: callers settle a False with the exact test."""
+    return math.isfinite(sum(a.reshape(-1).tolist()) if a.size <= 64 else a.sum())
+
+
+def _overflow(sys, what: str, *, feedback: bool = False) -> SimulationError:
+    """The error for a state beyond the float range: when, why, and what to try."""
+    return SimulationError(
+        f"the simulation left the float range (about 1.8e308): {what}. {_growth(sys, feedback)} "
+        "To see the growth, simulate a shorter time (stop before this time) or plot |x| on a "
+        "log scale; to keep the state bounded, stabilize the system (chapter 3)."
+    )
+
+
+def _growth(sys, feedback: bool = False) -> str:
+    """Why the state grows: for a StateSpace, the eigenvalues of A (section 3.2.2)."""
+    if not isinstance(sys, StateSpace):
+        return ("The solution grows without bound: it runs away from an unstable equilibrium, "
+                "or has a finite escape time (as x' = x^2 does).")
+    lam = np.linalg.eigvals(sys.A)
+    of_a = ("of A alone (your input u(t, x) changes the dynamics: for u = K x look at the "
+            "eigenvalues of A + B K)" if feedback else "of A")
+    if sys.is_discrete:
+        rho = float(np.abs(lam).max())
+        verdict = (f"> 1: the system is unstable and |x| grows like {rho:.4g}^k, passing 1e308 "
+                   f"within about {709.8 / np.log(rho):.4g} steps") if rho > 1 else \
+            "<= 1: the growth comes from the input"
+        return f"The spectral radius (largest |eigenvalue|) {of_a} is {rho:.4g} {verdict}."
+    a = float(lam.real.max())
+    verdict = (f"> 0: the system is unstable (section 3.2.2) and |x| grows like e^({a:.4g} t), "
+               f"passing 1e308 within about {709.8 / a:.4g} time units") if a > 0 else \
+        "<= 0: the growth comes from the input"
+    return f"The largest real part of the eigenvalues {of_a} is {a:.4g} {verdict}."
+
+
+def _check_finite(sys, t: np.ndarray, x: np.ndarray, *, feedback: bool = False) -> None:
+    """Raise `_overflow` at the first sample where x (N, ...) is not finite."""
+    with np.errstate(over="ignore"):   # a sum of large finite entries may overflow: settled below
+        if math.isfinite(x.sum()):     # the cheap screen of `_screen`
+            return
+    bad = ~np.isfinite(x.reshape(t.size, -1)).all(axis=1)
+    if bad.any():
+        k = max(int(np.argmax(bad)), 1)
+        raise _overflow(sys, f"the state is finite up to t = {t[k - 1]:.6g} (largest |x| = "
+                        f"{np.abs(x[k - 1]).max():.3g}) and overflows by t = {t[k]:.6g}",
+                        feedback=feedback)
+
+
+def _solver_failure(sys, sol, last: list) -> SimulationError:
+    """The error for solve_ivp stopping early; `last` is the (t, x) of its last
+    evaluation of f (a trial step, so x is only shown when it has overflowed)."""
+    tk, xk = last
+    if _out_of_range(xk):
+        return _overflow(sys, f"the state reached {np.array2string(np.asarray(xk), precision=3)} "
+                         f"at t = {tk:.6g}")
+    reached = (f"the last sample it reached is t = {sol.t[-1]:.6g}, x = "
+               f"{np.array2string(sol.y[:, -1], precision=4)}" if np.size(sol.t) else
+               "it could not complete a first step")
+    return SimulationError(
+        f"the ODE solver stopped at t = {tk:.6g} ({reached}): {sol.message} Near this time the "
+        "solution may grow without bound (a finite escape time) or change too fast for the "
+        "method: for a stiff system try method='Radau' or method='LSODA'."
+    )
+
+
 def _input(sys, t: np.ndarray, u, x0: np.ndarray):
-    """Return (u_arr, u_fun): the input as samples, or as a function u(t, x)."""
+    """Return (u_arr, u_fun, u_user): the input as samples, or as a function u(t, x)
+    (a callable u checked once at (t0, x0)), and the user's own function or None."""
     m = sys.m
     if u is None:
-        return np.zeros((t.size, m)), (None if isinstance(sys, StateSpace) else lambda tk, xk: np.zeros(m))
+        zero = None if isinstance(sys, StateSpace) else (lambda tk, xk: np.zeros(m))
+        return np.zeros((t.size, m)), zero, None
     if callable(u):
-        def u_fun(tk, xk, _u=u):
-            return np.atleast_1d(np.asarray(_u(tk, xk), dtype=float)).ravel()
-        check_function_output(u, (t[0], x0), "u", size=m,
-                              what=f"the {m} input(s) at time t and state x")
-        return None, u_fun
+        _checked_call(u, (t[0], x0), "u", size=m, where=_where(t[0], x0),
+                      what=f"the {m} input(s) at time t and state x")
+
+        def u_fun(tk, xk):
+            value = np.asarray(u(tk, xk), dtype=float).reshape(-1)
+            if value.size != m:
+                raise ValueError(f"u returned {value.size} numbers, expected {m}")
+            return value
+        return None, u_fun, u
     if m == 0:
         raise ValueError("u was given, but the system has no input (m = 0); leave u=None.")
     u_arr = as_series(u, "u", samples=t.size, channels=m, channels_why="one column per input")
     if isinstance(sys, StateSpace) or sys.is_discrete:
-        return u_arr, None
+        return u_arr, None, None
 
     def interpolated(tk, xk):
         return np.array([np.interp(tk, t, u_arr[:, j]) for j in range(m)])
-    return u_arr, interpolated
+    return u_arr, interpolated, None
 
 
 def _check_discrete_grid(t: np.ndarray, dt: float) -> None:
@@ -207,36 +555,51 @@ def _check_discrete_grid(t: np.ndarray, dt: float) -> None:
         )
 
 
-def _iterate(sys, t, x0, u_arr, u_fun):
-    """Iterate x(k+1) = f(x(k), u(k)) (1.18) / (1.27), one step at a time, exactly as written."""
-    N, n = t.size, sys.n
-    if isinstance(sys, NonlinearSystem):
-        sys.check(x0, u_fun(t[0], x0) if u_fun else u_arr[0])
+def _iterate(model, t, x0, u_arr):
+    """Iterate x(k+1) = f(x(k), u(k)) (1.18) / (1.27), one step at a time, exactly as
+    written; each step guarded (`_Model.input`, `_Model.step`)."""
+    N, n, m = t.size, model.sys.n, model.sys.m
     x = np.empty((N, n))
-    u_out = np.empty((N, sys.m))
+    u_out = np.empty((N, m))
     x[0] = x0
     for k in range(N):
-        u_out[k] = u_fun(t[k], x[k]) if u_fun else u_arr[k]
+        u_out[k] = model.input(t[k], x[k]) if model.u_fun else u_arr[k]
         if k + 1 < N:
-            x[k + 1] = sys.f(x[k], u_out[k])
+            x[k + 1] = model.step(t[k], x[k], u_out[k])
     return x, u_out
 
 
-def lti_step_matrices(A: np.ndarray, B: np.ndarray, h: float):
+def lti_step_matrices(A, B, h):
     """Exact one-step matrices for x' = A x + B u with u linear over a step h.
 
     Returns ``(Ad, B0, B1)`` with ``x(k+1) = Ad x(k) + B0 u(k) + B1 u(k+1)``,
     from the matrix exponential of the augmented matrix
     ``[[A h, B h, 0], [0, 0, I], [0, 0, 0]]`` -- the integral in (2.4)
     evaluated in closed form for a piecewise-linear input.
+
+    Raises ValueError for a non-square A, a B without one row per state, or
+    a step h that is not a finite number > 0; `SimulationError` when
+    e^(A h) is beyond the float range (an unstable A and a long step).
     """
+    A = as_square(A, "A")
+    n = A.shape[0]
+    B = as_matrix(B, "B", rows=n, rows_why=f"one per state, since A is {n}x{n}",
+                  cols=1 if np.ndim(B) == 1 else None)
+    return _step_matrices(A, B, as_scalar(h, "h", positive=True))
+
+
+def _step_matrices(A: np.ndarray, B: np.ndarray, h: float):
+    """`lti_step_matrices` for checked arguments."""
     from scipy.linalg import expm
     n, m = B.shape
     M = np.zeros((n + 2 * m, n + 2 * m))
     M[:n, :n] = A * h
     M[:n, n:n + m] = B * h
     M[n:n + m, n + m:] = np.eye(m)
-    E = expm(M)
+    with np.errstate(over="ignore", invalid="ignore"):   # an overflow is raised just below
+        E = expm(M)
+    if not np.isfinite(E).all():
+        raise _overflow(StateSpace(A), f"e^(A h) over one step h = {h:g} is already beyond it")
     Ad, G0, G1 = E[:n, :n], E[:n, n:n + m], E[:n, n + m:]
     return Ad, G0 - G1, G1
 
@@ -244,7 +607,7 @@ def lti_step_matrices(A: np.ndarray, B: np.ndarray, h: float):
 def _lti_exact(sys: StateSpace, t: np.ndarray, x0: np.ndarray, u: np.ndarray) -> np.ndarray:
     """Exact response of a continuous LTI system to a piecewise-linear input."""
     if is_uniform(t):
-        Ad, B0, B1 = lti_step_matrices(sys.A, sys.B, t[1] - t[0])
+        Ad, B0, B1 = _step_matrices(sys.A, sys.B, t[1] - t[0])
         return _recurse(Ad, x0, [(B0, u[:-1]), (B1, u[1:])])
     x = np.empty((t.size, sys.n))
     x[0] = x0
@@ -252,7 +615,7 @@ def _lti_exact(sys: StateSpace, t: np.ndarray, x0: np.ndarray, u: np.ndarray) ->
     for k, h in enumerate(np.diff(t)):
         key = round(float(h), 12)
         if key not in cache:
-            cache[key] = lti_step_matrices(sys.A, sys.B, h)
+            cache[key] = _step_matrices(sys.A, sys.B, h)
         Ad, B0, B1 = cache[key]
         x[k + 1] = Ad @ x[k] + B0 @ u[k] + B1 @ u[k + 1]
     return x
@@ -396,24 +759,74 @@ def _recurse_complex(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
     return x
 
 
-def _integrate(sys, t, x0, u_fun: Callable, *, rtol, atol, method) -> np.ndarray:
-    """Integrate x' = f(x, u(t, x)) with solve_ivp, returning x on the grid t."""
+def _integrate(model, t, x0, options: dict) -> np.ndarray:
+    """Integrate x' = f(x, u(t, x)) with solve_ivp, returning x on the grid t.
+
+    Every evaluation is guarded (a plain call and one finiteness test, see
+    `_Model`): NaN/inf would otherwise make the solver shrink its step for ever.
+    """
     from scipy.integrate import solve_ivp
+    f, u_fun, n, last = model.f, model.u_fun, model.sys.n, [t[0], x0]
+    shape, ndarray, isfinite = (n,), np.ndarray, math.isfinite
 
     def rhs(tk, xk):
-        return sys.f(xk, u_fun(tk, xk))
+        last[0], last[1] = tk, xk
+        try:
+            dx = f(xk, u_fun(tk, xk))
+            # the fast test of `_screen`, inlined: this runs at every evaluation
+            if type(dx) is ndarray and dx.shape == shape and isfinite(sum(dx.tolist())):
+                return dx
+        except Exception as err:
+            model.fail(tk, xk, err)
+        return model.settle(tk, xk, dx, n)
 
-    sol = solve_ivp(rhs, (t[0], t[-1]), x0, t_eval=t, method=method, rtol=rtol, atol=atol)
-    if not sol.success or sol.y.shape[1] != t.size:
-        raise RuntimeError(
-            f"the ODE solver stopped at t={sol.t[-1] if sol.t.size else t[0]:g}: {sol.message}. "
-            "The solution may blow up (check the model), or the system may be stiff: "
-            "try method='LSODA' or method='Radau'."
-        )
+    sol = solve_ivp(rhs, (t[0], t[-1]), x0, t_eval=t, **options)
+    if not sol.success or np.size(sol.t) != t.size:
+        raise _solver_failure(model.sys, sol, last)
     return sol.y.T
 
 
-def _outputs(sys, x: np.ndarray, u: np.ndarray) -> np.ndarray:
+def _inputs_on_grid(model, t: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """u(t_k, x_k) at every sample (N, m), checked once at the end (`_Model.input`
+    explains the first bad sample)."""
+    u_fun, m = model.u_fun, model.sys.m
+    try:
+        u = np.array([u_fun(tk, xk) for tk, xk in zip(t, x)], dtype=float).reshape(t.size, m)
+        if np.isfinite(u).all():
+            return u
+    except Exception:
+        pass
+    return np.array([model.input(tk, xk) for tk, xk in zip(t, x)]).reshape(t.size, m)
+
+
+def _outputs(sys, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> np.ndarray:
+    """y at every sample: C x + D u, x itself, or the model's h, checked once at the
+    end (`_output_failure` explains the first bad sample)."""
     if isinstance(sys, StateSpace):
-        return x @ sys.C.T + u @ sys.D.T
-    return np.array([sys.h(xk, uk) for xk, uk in zip(x, u)]).reshape(x.shape[0], -1)
+        y = x @ sys.C.T + u @ sys.D.T
+        _check_finite(sys, t, y)
+        return y
+    if sys._h is None:
+        return x.copy()
+    h, rows = sys._h, []
+    try:
+        for xk, uk in zip(x, u):
+            rows.append(np.asarray(h(xk, uk), dtype=float).reshape(-1))
+        y = np.array(rows)
+        if y.ndim == 2 and np.isfinite(y).all():
+            return y
+    except Exception:
+        pass
+    for k in range(t.size):
+        _output_failure(sys, t[k], x[k], u[k], rows[0].size if rows else None)
+    raise UserFunctionError("h failed during the simulation, but returned finite values at every "
+                            "sample when called again: does it change between calls?")
+
+
+def _output_failure(sys, tk, xk, uk, size) -> None:
+    """Raise the error that explains why h fails at time tk, if it does (call_user's wording)."""
+    where = _where(tk, xk)
+    value = call_user(sys._h, (xk, uk), "h", where=where)
+    if size is not None and value.size != size:
+        raise UserFunctionError(f"h returned {value.size} numbers {where}, but {size} at the start; "
+                                "h must return the same number of outputs at every time.")

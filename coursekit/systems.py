@@ -14,12 +14,64 @@ from typing import Callable
 import numpy as np
 
 from ._validation import as_matrix, as_scalar, as_square, check_function_output
+from .diagnostics import UserFunctionError, call_user
 
 __all__ = ["StateSpace", "NonlinearSystem"]
 
 
 def _check_dt(dt, name: str = "dt") -> float | None:
     return None if dt is None else as_scalar(dt, name, positive=True)
+
+
+def _checked_call(func: Callable, args: tuple, name: str, *, size: int, what: str,
+                  where: str = "") -> np.ndarray:
+    """Call a user function once: an exception, None or NaN/inf is explained by
+    `call_user` (naming `name` and `where`), a wrong return shape by
+    `check_function_output`'s rule; returns the value as a flat float array."""
+    value = call_user(func, args, name, where=where)
+    try:
+        return check_function_output(lambda *_: value, args, name, size=size, what=what)
+    except ValueError as err:
+        if not where:
+            raise
+        raise UserFunctionError(f"{err} This happened {where}.") from None
+
+
+def _float_array(value, name: str) -> np.ndarray:
+    """value as a float array; complex or non-numeric values raise ValueError naming `name`."""
+    arr = np.asarray(value)
+    if arr.dtype.kind == "f":
+        return arr
+    if arr.dtype.kind == "c":
+        raise ValueError(f"{name} must contain real numbers: received complex entries.")
+    try:
+        return arr.astype(float, copy=False)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{name} must be an array of real numbers: received {type(value).__name__} "
+                         f"({err}).") from None
+
+
+def _state_and_input(x, u, n: int, m: int) -> tuple[np.ndarray, np.ndarray]:
+    """x of shape (n,) or a batch (n, ...) of states, u of shape (m,) or (m, ...) to match.
+
+    Raises ValueError naming x or u and the expected shape: a column x (n, 1)
+    with a flat u (m,) would otherwise broadcast into an (n, n) result.
+    With m = 0, u may be None or empty.
+    """
+    x = _float_array(x, "x")
+    if x.ndim == 0 or x.shape[0] != n:
+        raise ValueError(f"x has shape {x.shape}: expected ({n},), one entry per state, or ({n}, k) "
+                         "for a batch of k states as columns.")
+    batch = x.shape[1:]
+    if m == 0 and (u is None or np.size(u) == 0):
+        return x, np.zeros((0,) + batch)
+    u = _float_array(u, "u")
+    if x.ndim == 1 and u.size == m and u.ndim <= 1:
+        return x, u.reshape(m)
+    if u.shape != (m,) + batch:
+        raise ValueError(f"u has shape {u.shape}: expected {(m,) + batch} for x of shape {x.shape} "
+                         f"(one entry per input{', one column per state of the batch' if batch else ''}).")
+    return x, u
 
 
 class StateSpace:
@@ -90,12 +142,26 @@ class StateSpace:
         return self.dt is not None
 
     def f(self, x, u) -> np.ndarray:
-        """Right-hand side A x + B u (dx/dt, or x(t+1) in discrete time)."""
-        return self.A @ x + self.B @ u
+        """Right-hand side A x + B u (dx/dt, or x(t+1) in discrete time) (1.24).
+
+        x is (n,) and u (m,), or a batch: x (n, k) and u (m, k), states and
+        inputs as columns, giving (n, k). Other shapes raise ValueError
+        (u may be None or empty when m = 0).
+        """
+        x, u = _state_and_input(x, u, self.n, self.m)
+        return self._apply(self.A, self.B, x, u)
 
     def h(self, x, u) -> np.ndarray:
-        """Output C x + D u."""
-        return self.C @ x + self.D @ u
+        """Output C x + D u (1.24), with the shapes of `f`: (p,) or (p, k)."""
+        x, u = _state_and_input(x, u, self.n, self.m)
+        return self._apply(self.C, self.D, x, u)
+
+    @staticmethod
+    def _apply(M, N, x, u) -> np.ndarray:
+        """M x + N u for one state or a batch (n, ...) of them."""
+        flat_x = x.reshape(x.shape[0], -1)
+        flat_u = u.reshape(u.shape[0], flat_x.shape[1])
+        return (M @ flat_x + N @ flat_u).reshape((M.shape[0],) + x.shape[1:])
 
     def poles(self) -> np.ndarray:
         """Eigenvalues of A, i.e. the poles of the system (section 3.2)."""
@@ -158,24 +224,39 @@ class NonlinearSystem:
         return self.dt is not None
 
     def f(self, x, u) -> np.ndarray:
-        """Evaluate the vector field f(x, u)."""
+        """Evaluate the vector field f(x, u).
+
+        x is (n,) and u (m,), or a batch (n, ...) and (m, ...) for a
+        function written on the rows x[0], x[1], ...; other shapes raise
+        ValueError naming x or u (u may be None or empty when m = 0).
+        """
+        x, u = _state_and_input(x, u, self.n, self.m)
         return np.asarray(self._f(x, u), dtype=float)
 
     def h(self, x, u) -> np.ndarray:
-        """Evaluate the output map h(x, u) (x itself by default)."""
+        """Evaluate the output map h(x, u) (x itself by default); shapes as in `f`."""
+        x, u = _state_and_input(x, u, self.n, self.m)
         if self._h is None:
-            return np.asarray(x, dtype=float)
+            return x.copy()
         return np.atleast_1d(np.asarray(self._h(x, u), dtype=float))
 
     def output_size(self, x, u) -> int:
         """Number of outputs, found by evaluating h once at (x, u)."""
         return self.h(np.asarray(x, float), np.asarray(u, float)).size
 
-    def check(self, x, u) -> None:
-        """Call f once at (x, u) and explain a wrong return shape (ValueError)."""
+    def check(self, x, u, *, where: str = "") -> None:
+        """Call f, and h if given, once at (x, u) and explain what is wrong.
+
+        Raises `UserFunctionError` (a ValueError) when either raises or
+        returns None or NaN/inf, naming the function and `where` (e.g.
+        "at t = 0, x = [1. 0.]"), and ValueError when f does not return n
+        numbers.
+        """
         word = "x(t+1)" if self.is_discrete else "dx/dt"
-        check_function_output(self._f, (x, u), "f", size=self.n,
-                              what=f"{word}, one entry per state for n={self.n}")
+        _checked_call(self._f, (x, u), "f", size=self.n, where=where,
+                      what=f"{word}, one entry per state for n={self.n}")
+        if self._h is not None:
+            call_user(self._h, (x, u), "h", where=where)
 
     def __repr__(self) -> str:
         kind = "continuous" if self.dt is None else f"discrete, dt={self.dt:g}"

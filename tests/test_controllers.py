@@ -2,7 +2,7 @@
 
 import numpy as np
 import pytest
-from hypothesis import given, strategies as st
+from hypothesis import given, settings, strategies as st
 
 import coursekit as ck
 from conftest import sorted_eig
@@ -68,7 +68,7 @@ def test_tracking_controller_follows_a_feasible_trajectory_3_104():
     res = ck.simulate(ck.StateSpace(A, B), T, u=ctrl, x0=[1, -1])
     err = res.x - np.array([x_d(t) for t in T])
     assert np.abs(err[0]).max() > 0.9 and np.abs(err[-1]).max() < 1e-6
-    with pytest.raises(ValueError, match=r"x_d\(0\) returned 1 numbers; expected 2"):
+    with pytest.raises(ValueError, match=r"x_d returned shape \(1,\); expected 2 numbers.*at t = 0"):
         ck.TrackingController([[1, 2]], lambda t: [0.0], u_d)
 
 
@@ -160,3 +160,69 @@ def test_bad_inputs():
         ck.PendulumLinearizingController([-1, -2, -3])
     with pytest.raises(ValueError, match="continuous-time"):
         ck.with_integrators(ck.StateSpace([[0.5]], [[1]], dt=1))
+
+
+# ---------------------------------------------------------------- shapes of x, wrapped x_d / u_d
+
+K2 = np.array([[-2.0, -3.0]])
+
+
+def _controllers():
+    """Every controller callable with a 2-state plant, m = 1."""
+    x_d = lambda t: np.array([np.sin(t), np.cos(t)])                          # noqa: E731
+    return [ck.StateFeedback(K2, [1.0, 0.0], [0.5]),
+            ck.TrackingController(K2, x_d, lambda t: np.array([-np.sin(t)])),
+            ck.IntegralFeedback([[-1.0, -2.0]], 1),
+            ck.PendulumLinearizingController([-2, -3], theta_ref=np.pi)]
+
+
+@pytest.mark.parametrize("bad", [np.ones((1, 2)), np.ones(3), np.ones((3, 1)), np.ones((2, 2, 2)),
+                                 np.ones(())])
+@pytest.mark.parametrize("ctrl", _controllers(), ids=lambda c: type(c).__name__)
+def test_controllers_reject_a_misshaped_state(ctrl, bad):
+    # a row (1, 2) used to broadcast against x_eq into a (1, 2) answer, silently
+    with pytest.raises(ValueError, match=r"x(_E)? has shape .*: expected \(2,\), one entry per state, "
+                                         r"or \(2, k\) for a batch"):
+        ctrl(0.3, bad)
+
+
+@settings(max_examples=20)
+@given(st.integers(1, 6), st.integers(0, 10_000))
+def test_every_controller_on_a_batch_is_the_column_by_column_answer(k, seed):
+    X = np.random.default_rng(seed).normal(size=(2, k))
+    for ctrl in _controllers():
+        batch = ctrl(0.3, X)
+        assert batch.shape == (1, k)
+        single = np.column_stack([ctrl(0.3, X[:, j]) for j in range(k)])
+        # the same products, grouped differently by BLAS: equal to rounding
+        np.testing.assert_allclose(batch, single, rtol=1e-13, atol=1e-13)
+
+
+def test_a_column_state_is_a_batch_of_one():
+    ctrl = ck.StateFeedback(K2)
+    assert ctrl(0, np.array([[1.0], [2.0]])).shape == (1, 1)
+    assert ctrl(0, [1.0, 2.0]).shape == (1,)
+
+
+def test_tracking_controller_wraps_failures_of_x_d_and_u_d_with_the_time():
+    ctrl = ck.TrackingController(K2, lambda t: [0.0, 0.0] if t < 1 else [1 / 0],
+                                 lambda t: [0.0] if t < 2 else [np.inf])
+    with pytest.raises(ck.UserFunctionError, match=r"x_d raised ZeroDivisionError at t = 1\b") as info:
+        ctrl(1.0, [0.0, 0.0])
+    assert isinstance(info.value.__cause__, ZeroDivisionError)
+    ctrl = ck.TrackingController(K2, lambda t: [0.0, 0.0], lambda t: [0.0] if t < 2 else [np.inf])
+    with pytest.raises(ck.UserFunctionError, match=r"u_d returned NaN or inf at t = 2\.5"):
+        ctrl(2.5, [0.0, 0.0])
+    ctrl = ck.TrackingController(K2, lambda t: [0.0, 0.0] if t < 1 else [0.0], lambda t: [0.0])
+    with pytest.raises(ValueError, match=r"x_d returned shape \(1,\); expected 2 numbers.*at t = 1\.5"):
+        ctrl(1.5, [0.0, 0.0])
+    with pytest.raises(ck.UserFunctionError, match=r"x_d raised TypeError at t = 0"):
+        ck.TrackingController(K2, lambda t: None + 1, lambda t: [0.0])
+
+
+def test_with_integrators_takes_a_batch_like_its_plant():
+    sys = ck.with_integrators(ck.models.pendulum(d_theta=0.2), r=[0.5])
+    X, U = np.random.default_rng(1).normal(size=(3, 4)), np.zeros((1, 4))
+    batch = sys.f(X, U)
+    single = np.column_stack([sys.f(X[:, j], U[:, j]) for j in range(4)])
+    np.testing.assert_allclose(batch, single, rtol=1e-13, atol=1e-13)   # rounding only

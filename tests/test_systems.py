@@ -2,6 +2,7 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings, strategies as st
 
 import coursekit as ck
 
@@ -55,3 +56,93 @@ def test_as_series_makes_a_one_dimensional_signal_a_column():
         as_series([1.0, 2.0], "u", samples=3)
     with pytest.raises(ValueError, match=r"u has the wrong number of columns: received shape \(3, 1\), expected 2"):
         as_series([1.0, 2.0, 3.0], "u", samples=3, channels=2)
+
+
+# ---------------------------------------------------------------- shapes of x and u in f and h
+
+PLANT = ck.StateSpace([[0, 1], [-2, -0.5]], [[0], [1]], [[1, 0]], [[0.5]])
+PEND = ck.models.pendulum()
+
+
+@pytest.mark.parametrize("sys", [PLANT, PEND], ids=["StateSpace", "NonlinearSystem"])
+@pytest.mark.parametrize("method", ["f", "h"])
+def test_a_column_state_with_a_flat_input_is_refused_not_broadcast(sys, method):
+    # x (2, 1) against u (1,) used to give an (2, 2) answer from A @ x + B @ u
+    with pytest.raises(ValueError, match=r"u has shape \(1,\): expected \(1, 1\) for x of shape \(2, 1\)"):
+        getattr(sys, method)(np.ones((2, 1)), np.ones(1))
+
+
+@pytest.mark.parametrize("sys", [PLANT, PEND], ids=["StateSpace", "NonlinearSystem"])
+@pytest.mark.parametrize("x, u, message", [
+    (np.ones(3), [0.0], r"x has shape \(3,\): expected \(2,\), one entry per state, or \(2, k\)"),
+    (np.ones((1, 2)), [0.0], r"x has shape \(1, 2\)"),
+    (np.ones(()), [0.0], r"x has shape \(\)"),
+    (np.ones(2), [0.0, 1.0], r"u has shape \(2,\): expected \(1,\)"),
+    (np.ones((2, 3)), np.ones((1, 2)), r"u has shape \(1, 2\): expected \(1, 3\)"),
+    (np.ones(2) * 1j, [0.0], r"x must contain real numbers"),
+    (["a", "b"], [0.0], r"x must be an array of real numbers"),
+])
+def test_f_and_h_name_the_misshaped_argument(sys, x, u, message):
+    for method in (sys.f, sys.h):
+        with pytest.raises(ValueError, match=message):
+            method(x, u)
+
+
+@settings(max_examples=25)
+@given(st.integers(1, 4), st.integers(0, 3), st.integers(1, 5), st.integers(0, 10_000))
+def test_statespace_f_and_h_on_a_batch_are_the_column_by_column_answers(n, m, k, seed):
+    rng = np.random.default_rng(seed)
+    sys = ck.StateSpace(rng.normal(size=(n, n)), rng.normal(size=(n, m)), rng.normal(size=(2, n)),
+                        rng.normal(size=(2, m)))
+    X, U = rng.normal(size=(n, k)), rng.normal(size=(m, k))
+    for method in (sys.f, sys.h):
+        batch = method(X, U)
+        single = np.column_stack([method(X[:, j], U[:, j]) for j in range(k)])
+        # the same sums of products in another grouping: equal to rounding
+        np.testing.assert_allclose(batch, single, rtol=1e-12, atol=1e-12)
+        # a grid of states (n, k, 2), as the explorers pass them: still column by column
+        grid = method(np.stack([X, 2 * X], axis=-1), np.stack([U, 2 * U], axis=-1))
+        np.testing.assert_allclose(grid[..., 1], 2 * batch, rtol=1e-12, atol=1e-12)
+
+
+def test_no_input_may_be_none_or_empty():
+    sys = ck.StateSpace([[0, 1], [-1, 0]])
+    for u in (None, [], np.zeros(0)):
+        np.testing.assert_array_equal(sys.f([1.0, 2.0], u), [2.0, -1.0])
+    assert sys.f(np.ones((2, 3)), None).shape == (2, 3)
+    lorenz = ck.models.lorenz()
+    np.testing.assert_allclose(lorenz.f([1.0, 2.0, 3.0], []), [10.0, -5.0, -1.0])   # (1.9) by hand
+
+
+def test_check_names_where_f_or_h_fail():
+    sys = ck.NonlinearSystem(lambda x, u: -np.sqrt(x), n=1, h=lambda x, u: 1 / float(x[0]))
+    with np.errstate(invalid="ignore"):
+        with pytest.raises(ck.UserFunctionError, match=r"f returned NaN or inf at x0"):
+            sys.check(np.array([-1.0]), np.zeros(0), where="at x0")
+    with pytest.raises(ck.UserFunctionError, match=r"h raised ZeroDivisionError at x0"):
+        sys.check(np.array([0.0]), np.zeros(0), where="at x0")
+
+
+@pytest.mark.parametrize("args, message", [
+    (([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], [[1.0], [1.0]], 0.1), r"A must be square"),
+    ((np.eye(2), np.ones((3, 1)), 0.1), r"B has the wrong number of rows: received shape \(3, 1\), expected 2"),
+    ((np.eye(2), np.ones((2, 1)), 0.0), r"h must be positive"),
+    ((np.eye(2), np.ones((2, 1)), -0.1), r"h must be positive"),
+    ((np.eye(2), np.ones((2, 1)), np.nan), r"h contains NaN"),
+    ((np.eye(2), np.ones((2, 1)), np.inf), r"h contains NaN or infinite"),
+    ((np.eye(2), np.ones((2, 1)), [0.1, 0.2]), r"h must be a single number"),
+    (([[np.nan, 0], [0, 1]], np.ones((2, 1)), 0.1), r"A contains NaN"),
+])
+def test_lti_step_matrices_validates_its_arguments(args, message):
+    with pytest.raises(ValueError, match=message):
+        ck.lti_step_matrices(*args)
+
+
+def test_lti_step_matrices_accept_a_flat_b_and_match_the_exponential():
+    from scipy.linalg import expm
+    A = np.array([[0.0, 1.0], [-2.0, -0.5]])
+    Ad, B0, B1 = ck.lti_step_matrices(A, [0.0, 1.0], 0.1)
+    np.testing.assert_allclose(Ad, expm(0.1 * A), rtol=1e-14, atol=1e-15)   # the same expm, sliced
+    # a constant input: B0 + B1 is the zero-order-hold integral A^-1 (e^(A h) - I) B
+    np.testing.assert_allclose(B0 + B1, np.linalg.solve(A, expm(0.1 * A) - np.eye(2)) @ [[0.0], [1.0]],
+                               rtol=1e-12, atol=1e-14)
