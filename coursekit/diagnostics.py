@@ -22,7 +22,9 @@ from typing import Callable
 
 import numpy as np
 
-__all__ = ["CoursekitWarning", "AccuracyWarning", "UserFunctionError", "call_user", "warn_accuracy"]
+from ._validation import _is_complex
+
+__all__ = ["CoursekitWarning", "AccuracyWarning", "UserFunctionError", "call_user"]
 
 
 class CoursekitWarning(UserWarning):
@@ -49,6 +51,8 @@ def call_user(func: Callable, args: tuple, name: str, *, where: str = "",
     ("at t = 0.3", "at x_eq") when the call raises, returns something that
     is not numbers, or (with `finite`) returns NaN or inf.
     """
+    if not callable(func):
+        raise TypeError(f"{name} must be a function: received {type(func).__name__}.")
     place = f" {where}" if where else ""
     try:
         out = func(*args)
@@ -59,23 +63,23 @@ def call_user(func: Callable, args: tuple, name: str, *, where: str = "",
         ) from err
     if out is None:
         raise UserFunctionError(f"{name} returned None{place}; did the function forget to return?")
+    if _is_complex(out):
+        raise UserFunctionError(f"{name} returned complex numbers{place}; expected real numbers.")
     try:
         arr = np.asarray(out, dtype=float)
     except (TypeError, ValueError) as err:
         raise UserFunctionError(
             f"{name} returned {type(out).__name__}{place}, which is not an array of real numbers ({err})."
         ) from None
-    if np.iscomplexobj(np.asarray(out)):
-        raise UserFunctionError(f"{name} returned complex numbers{place}; expected real numbers.")
     if finite and not np.all(np.isfinite(arr)):
         raise UserFunctionError(
-            f"{name} returned NaN or inf{place}: {np.array2string(arr, precision=4)}. Check the "
-            "model for a division by zero, a square root or logarithm of a negative number, or a "
+            f"{name} returned NaN or inf{place}: {np.array2string(arr, precision=4)}. Look in "
+            f"{name} for a division by zero, a square root or logarithm of a negative number, or a "
             "state that has grown without bound."
         )
     return arr
 
 
 def warn_accuracy(message: str, *, stacklevel: int = 3) -> None:
-    """Issue an `AccuracyWarning` pointing at the caller of the public function."""
+    """Issue an `AccuracyWarning` pointing at the caller of the public function (internal)."""
     warnings.warn(message, AccuracyWarning, stacklevel=stacklevel)

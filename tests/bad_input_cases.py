@@ -661,7 +661,6 @@ bad("find_widget_frontend", "dirs a number", lambda: ck.find_widget_frontend(3),
 ok("call_user", "good", lambda: ck.call_user(lambda x: x, (np.ones(2),), "g"))
 bad("call_user", "user function raises", lambda: ck.call_user(lambda x: 1 / 0, (1.0,), "g"), "g")
 bad("call_user", "func not callable", lambda: ck.call_user(3.0, (1.0,), "g"), "g")
-bad("warn_accuracy", "message not a string", lambda: ck.warn_accuracy(None), "message")
 
 # ---------------------------------------------------------------------------
 # models
