@@ -196,7 +196,7 @@ def test_open_loop_control_errors():
         ck.open_loop_control([[0, 1], [0, 0]], [[0], [1]], [0, 0], [1, 1], -1.0)
     with pytest.raises(ValueError, match=r"B must have a single column"):
         ck.open_loop_control(np.eye(2), np.eye(2), [0, 0], [1, 1], 1.0)
-    with pytest.raises(ValueError, match=r"smooth must be >= 0"):
+    with pytest.raises(ValueError, match=r"smooth must be at least 0"):
         ck.open_loop_control([[0, 1], [0, 0]], [[0], [1]], [0, 0], [1, 1], 1.0, smooth=-1)
 
 
