@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_vector
-from .diagnostics import call_user
-from .linearization import _function_name
+from ._validation import as_integer, as_matrix, as_scalar, as_vector
+from .diagnostics import UserFunctionError, call_user
+from .linearization import _function_name, _sympy_column
 from .systems import NonlinearSystem, StateSpace
 
 __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
@@ -83,21 +83,61 @@ def find_equilibria(f, u_eq=None, guesses=None, *, n=None, dt=None, bounds=(-5.0
 
     An exception raised by f becomes a `UserFunctionError` (a ValueError)
     naming the function, the point and the guess the search started from.
+    Before searching, f is evaluated at every guess: it must return n numbers
+    (ValueError otherwise; for a bare function without `n`, n is the number
+    of columns of `guesses`, and the message names both), and it must be
+    finite at one guess at least (`UserFunctionError` otherwise; NaN at some
+    guesses is the edge of f's domain, and those searches fail quietly).
+    `n`, `count` (>= 1), `seed`, `bounds` (low < high) and `tol` (> 0) are
+    checked, each ValueError naming its argument.
     """
+    if n is not None:
+        n = as_integer(n, "n", minimum=1, why="the number of states of the system")
     func, name, n_sys, m, sys_dt = _field(f, n, dt)
     dt = sys_dt if dt is None else as_scalar(dt, "dt", positive=True)
+    tol = as_scalar(tol, "tol", positive=True)
     u = _input(u_eq, m)
-    X0 = _guesses(guesses, n_sys if n_sys is not None else n, bounds, count, seed)
+    X0 = _guesses(guesses, n_sys, bounds, count, seed)
+    task = "find_equilibria, searching from the guess {}"
+    _check_at_guesses(func, name, dt, u, X0, task, inferred=n_sys is None)
     from scipy.optimize import root
     found = []
     for x0 in X0:
-        residual = _residual(func, name, dt, f"find_equilibria, searching from the guess {x0.tolist()}")
+        residual = _residual(func, name, dt, task.format(x0.tolist()))
         # a guess outside the model's domain (a square root of a negative state) fails quietly
         with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
             sol = root(lambda x: residual(x, u), x0, method="hybr", tol=1e-12)
             if np.all(np.isfinite(sol.x)) and _is_zero(residual(sol.x, u), tol, sol.x):
                 found.append(sol.x)
     return _unique(found, X0.shape[1])
+
+
+def _check_at_guesses(func, name: str, dt, u, X0, task: str, *, inferred: bool) -> None:
+    """Refuse an f that returns the wrong number of values, or NaN/inf at every guess.
+
+    NaN at some guesses is a model's domain (a square root of a negative state)
+    and those searches fail quietly; NaN at all of them leaves nothing to search
+    from. `inferred`: the number of states was read off the guesses' columns.
+    """
+    with np.errstate(invalid="ignore", divide="ignore", over="ignore"):
+        values = [_residual(func, name, dt, task.format(x0.tolist()))(x0, u) for x0 in X0[:1]]
+        n = X0.shape[1]
+        if values[0].size != n:
+            source = " (taken from the columns of guesses)" if inferred else ""
+            raise ValueError(
+                f"{name} returned {values[0].size} numbers at x = {X0[0].tolist()}; expected {n}, "
+                f"one per state{source}: dx/dt has one entry per state. Check that f returns "
+                "every component of dx/dt" + (" and that guesses has one column per state."
+                                              if inferred else ".")
+            )
+        values += [_residual(func, name, dt, task.format(x0.tolist()))(x0, u) for x0 in X0[1:]]
+    if not any(np.all(np.isfinite(v)) for v in values):
+        raise UserFunctionError(
+            f"{name} returned NaN or inf at every one of the {len(X0)} starting points (e.g. "
+            f"{np.array2string(values[0], precision=4)} at x = {X0[0].tolist()}), so no search "
+            f"can start. Look in {name} for a division by zero or a square root or logarithm of "
+            "a negative number, or give guesses inside the region where f is defined."
+        )
 
 
 def _input(u_eq, m):
@@ -114,11 +154,12 @@ def _guesses(guesses, n, bounds, count, seed) -> np.ndarray:
     if n is None:
         raise ValueError("n is missing: with a bare function f(x, u) and no guesses, pass n= (the "
                          "number of states) so that starting points can be drawn.")
-    lo, hi = (as_scalar(b, "bounds") for b in bounds)
+    lo, hi = as_vector(bounds, "bounds", size=2, why="(low, high)")
     if not hi > lo:
         raise ValueError(f"bounds must be (low, high) with low < high: received {bounds!r}.")
-    rng = np.random.default_rng(seed)
-    return rng.uniform(lo, hi, size=(int(count), int(n)))
+    count = as_integer(count, "count", minimum=1, why="the number of random starting points")
+    rng = np.random.default_rng(as_integer(seed, "seed", minimum=0))
+    return rng.uniform(lo, hi, size=(count, int(n)))
 
 
 def _unique(points, n: int) -> np.ndarray:
@@ -143,17 +184,23 @@ def equilibrium_input(f, x_eq, *, m=None, u_guess=None, tol: float = 1e-9) -> np
     (3.55): any x* with x2* != 0); a NaN or inf residual never passes. `m` is
     needed only for a bare function. An exception raised by f, or NaN/inf it
     returns at the starting input, becomes a `UserFunctionError` (a
-    ValueError) naming the function and the point.
+    ValueError) naming the function and the point. Without `m`, a bare
+    function takes the number of inputs from the length of `u_guess`; f must
+    return one number per entry of `x_eq` (ValueError naming both otherwise).
     """
     func, name, n, m_sys, dt = _field(f)
-    m = m_sys if m_sys is not None else (None if m is None else int(as_scalar(m, "m", integer=True)))
-    if m is None or m < 1:
-        raise ValueError("m must be the number of inputs (>= 1): pass m= for a bare function f(x, u).")
+    tol = as_scalar(tol, "tol", positive=True)
     x = as_vector(x_eq, "x_eq", size=n)
-    u0 = np.zeros(m) if u_guess is None else as_vector(u_guess, "u_guess", size=m)
+    u0 = _input_guess(m_sys, m, u_guess)
     task = "equilibrium_input, solving f(x_eq, u) = 0 for u"
     # the starting point must be finite, or the search has nowhere to go
-    _residual(func, name, dt, task + " from u_guess", finite=True)(x, u0)
+    f0 = _residual(func, name, dt, task + " from u_guess", finite=True)(x, u0)
+    if f0.size != x.size:
+        raise ValueError(
+            f"{name} returned {f0.size} numbers at x_eq = {x.tolist()}; expected {x.size}, one "
+            "per entry of x_eq (dx/dt has one entry per state). Check that x_eq lists every "
+            "state and that f returns every component of dx/dt."
+        )
     residual = _residual(func, name, dt, task)
     from scipy.optimize import least_squares
     sol = least_squares(lambda u: residual(x, u), u0, xtol=1e-14, ftol=1e-14, gtol=1e-14)
@@ -165,6 +212,23 @@ def equilibrium_input(f, x_eq, *, m=None, u_guess=None, tol: float = 1e-9) -> np
             "that the rows of f without input can vanish (e.g. zero velocities)."
         )
     return sol.x
+
+
+def _input_guess(m_sys, m, u_guess) -> np.ndarray:
+    """The starting input: u_guess checked against m, or zeros(m); m read off u_guess if not given."""
+    if m_sys is None and m is not None:
+        m = as_integer(m, "m", minimum=1, why="equilibrium_input solves for an input")
+    elif m_sys is not None:
+        m = m_sys
+    if u_guess is not None:
+        u0 = as_vector(u_guess, "u_guess", size=m, why="one per input of the system")
+        if u0.size:
+            return u0
+    if m is None or m < 1:
+        raise ValueError("m must be the number of inputs (>= 1): pass m= (or a u_guess with one "
+                         "entry per input) for a bare function f(x, u); a system without input has "
+                         "no u* to find.")
+    return np.zeros(m)
 
 
 def symbolic_equilibria(f, unknowns, *, discrete: bool = False):
@@ -181,8 +245,8 @@ def symbolic_equilibria(f, unknowns, *, discrete: bool = False):
     removes the solutions at 0.
     """
     import sympy as sp
-    F = list(sp.Matrix(f))
-    X = list(unknowns)
+    F = list(_sympy_column(f, "f"))
+    X = list(_sympy_column(unknowns, "unknowns")) if unknowns is not None else []
     if not X or not all(isinstance(v, sp.Symbol) for v in X):
         raise ValueError(f"unknowns must be a non-empty list of sympy symbols: received {unknowns!r}.")
     if discrete:

@@ -31,7 +31,7 @@ import numpy as np
 from ._validation import as_matrix, as_scalar, as_vector
 from .controllability import _pair, ccf_transform, charpoly
 from .diagnostics import warn_accuracy
-from .trajectory import _PLAN_RTOL, plot_plan, poly_trajectory
+from .trajectory import _PLAN_RTOL, _input_time, _plan_grid, plot_plan, poly_trajectory
 
 __all__ = [
     "FlatSystem",
@@ -66,9 +66,8 @@ class FlatSystem:
 
     def phi(self, x) -> np.ndarray:
         """Flat output F = phi(x); x of shape (n,) or (N, n)."""
-        arr = np.asarray(x, dtype=float)
-        single = arr.ndim == 1
-        X = as_matrix(arr.reshape(1, -1) if single else arr, "x", cols=self.n,
+        single = np.ndim(x) == 1
+        X = as_matrix(x, "x", rows=1 if single else None, cols=self.n,
                       cols_why=f"one per state of the {self.name}")
         F = self._phi(X)
         return F[0] if single else F
@@ -243,8 +242,8 @@ def two_wheeled_flatness(reverse: bool = False) -> FlatSystem:
     arctan(F2'/F1') is wrong whenever the robot drives in -x1 direction),
     ``u1 = |F'|`` (2.99) and ``u2 = (F2'' F1' - F1'' F2') / |F'|^2`` (2.101).
     With ``reverse=True`` the robot drives backwards: u1 = -|F'| and theta
-    is turned by pi. Singular at zero speed (F' = 0), where a ValueError
-    explains why.
+    is turned by pi (`reverse` must be True or False: ValueError otherwise).
+    Singular at zero speed (F' = 0), where a ValueError explains why.
     """
     def turn_rate(D, speed_sq, v):
         # (2.100)-(2.101): u2 = theta'
@@ -275,8 +274,16 @@ def car_like_flatness(L: float = 2.5, reverse: bool = False) -> FlatSystem:
     return _robot_flatness("car-like robot", reverse, steering, dict(L=L))
 
 
+def _as_flag(value, name: str) -> bool:
+    """`value` as a bool; anything but True/False (a string "yes", None, 1) is refused, naming `name`."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False: received {type(value).__name__} {value!r}.")
+    return bool(value)
+
+
 def _robot_flatness(name: str, reverse: bool, second_input: Callable, params: dict) -> FlatSystem:
     """The flat maps shared by both robots; `second_input(D, |F'|^2, v)` gives u2."""
+    reverse = _as_flag(reverse, "reverse")
     sign = -1.0 if reverse else 1.0
 
     def psi_x(D):
@@ -290,7 +297,7 @@ def _robot_flatness(name: str, reverse: bool, second_input: Callable, params: di
         return np.hstack([v, second_input(D, speed_sq, v)])
 
     return FlatSystem(name=name, n=3, m=2, order_x=1, order_u=2, phi=_planar_phi,
-                      psi_x=psi_x, psi_u=psi_u, params=dict(params, reverse=bool(reverse)))
+                      psi_x=psi_x, psi_u=psi_u, params=dict(params, reverse=reverse))
 
 
 class FlatPlan:
@@ -336,7 +343,7 @@ class FlatPlan:
 
     def input(self, t, x=None) -> np.ndarray:
         """``u(t, x)`` for `simulate`: open loop, x is ignored (t is clipped to [0, T])."""
-        tt = min(max(float(t), 0.0), self.horizon)
+        tt = _input_time(t, self.horizon)
         # the same maps as u(t), without re-checking the inputs at every solver step
         columns = [traj._scalar_derivatives(tt, self.flat.order_u) for traj in self.trajectories]
         D = [np.array([[col[k] for col in columns]]) for k in range(self.flat.order_u + 1)]
@@ -344,7 +351,7 @@ class FlatPlan:
 
     def plot(self, samples: int = 301):
         """Figure of the planned state psi_x and input psi_u on [0, T]; returns the figure."""
-        t = np.linspace(0.0, self.horizon, int(as_scalar(samples, "samples", positive=True, integer=True)))
+        t = _plan_grid(self.horizon, samples)
         return plot_plan(t, self.x(t), self.u(t), title=f"flat plan for the {self.flat.name} (2.88)-(2.89)")
 
     @property
@@ -364,8 +371,8 @@ class FlatPlan:
 
 def _boundary(value, name: str, m: int) -> np.ndarray:
     """Boundary conditions as an (r, m) array: row k is the k-th derivative of F."""
-    arr = np.asarray(value, dtype=float)
-    if m == 1 and arr.ndim <= 1:
+    # the shape only: as_vector / as_matrix reject text, complex, NaN, naming `name`
+    if m == 1 and np.ndim(value) <= 1:
         return as_vector(value, name).reshape(-1, 1)
     return as_matrix(value, name, cols=m, cols_why=f"one per flat output (m = {m})")
 

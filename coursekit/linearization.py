@@ -20,7 +20,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_scalar, as_vector
+from ._validation import _is_complex, as_scalar, as_vector
 from .diagnostics import call_user, warn_accuracy
 from .systems import NonlinearSystem, StateSpace
 
@@ -299,6 +299,7 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     """
     func, name, x, u, n, m, sys_dt = _vector_field(f, x_eq, u_eq)
     dt = sys_dt if dt is None else as_scalar(dt, "dt", positive=True)
+    tol = as_scalar(tol, "tol", positive=True)
 
     def checked(xx, uu, where):
         return np.ravel(call_user(func, (xx, uu), name, where=where))
@@ -348,8 +349,9 @@ def symbolic_jacobian(f, variables):
 def linearize_symbolic(f, x, u=None, x_eq=None, u_eq=None):
     """Exact (A, B) of sympy expressions f(x, u) at (x*, u*): (3.80) symbolically.
 
-    `x` and `u` are lists of symbols; `x_eq` and `u_eq` are lists of values
-    (numbers or expressions) of the same length. Returns sympy matrices,
+    `x` and `u` are lists of symbols; `x_eq` and `u_eq` are lists of real
+    values (numbers or expressions) of the same length; complex values raise
+    ValueError. Returns sympy matrices,
     simplified; without `u` B has zero columns.
     """
     import sympy as sp
@@ -369,6 +371,9 @@ def linearize_symbolic(f, x, u=None, x_eq=None, u_eq=None):
 
 def _sympy_column(values, name: str):
     import sympy as sp
+    if isinstance(values, str):
+        raise ValueError(f"{name} must be a list of sympy expressions: received the text {values!r}; "
+                         "build expressions from symbols, e.g. x1, x2 = sp.symbols('x1 x2').")
     try:
         M = sp.Matrix(values)
     except (TypeError, ValueError, sp.SympifyError):
@@ -380,6 +385,9 @@ def _sympy_column(values, name: str):
 
 def _values(values, size: int, name: str) -> list:
     vals = list(values) if isinstance(values, (list, tuple)) else list(np.ravel(values))
+    if _is_complex(vals):
+        raise ValueError(f"{name} must contain real values: received {vals!r} with complex entries; "
+                         "an equilibrium of a real system is real.")
     if len(vals) != size:
         raise ValueError(f"{name} has the wrong length: received {len(vals)} values, expected {size}.")
     return vals

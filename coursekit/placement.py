@@ -35,12 +35,18 @@ def poly_from_roots(poles) -> np.ndarray:
     """Monic polynomial with the given roots, ascending ``[p_0, ..., p_{n-1}]`` (3.43).
 
     ``poles`` must be finite numbers, complex ones in conjugate pairs (a real
-    polynomial has no other roots); otherwise `ValueError` names the problem.
+    polynomial has no other roots), and at least one (degree n >= 1: an empty
+    list is almost always a mistake, and the degree-0 polynomial 1 has no
+    coefficients to return); otherwise `ValueError` names the problem. Any
+    number n of roots is accepted: the degree is the number of roots.
     """
     try:
         count = int(np.size(poles))
     except (TypeError, ValueError):
-        count = 0              # as_poles explains why poles is not a list of numbers
+        count = 1              # as_poles explains why poles is not a list of numbers
+    if count == 0:
+        raise ValueError("poles is empty: received no roots; pass at least one, e.g. "
+                         "poly_from_roots([-1, -2]) for s^2 + 3 s + 2.")
     poles = as_poles(poles, "poles", count=count)
     return np.real(np.poly(poles))[::-1][:-1].copy()
 

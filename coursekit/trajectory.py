@@ -23,9 +23,9 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_scalar, as_series, as_vector
+from ._validation import as_integer, as_scalar, as_series, as_vector, time_grid
 from .controllability import _pair, ccf_transform, charpoly
-from .diagnostics import warn_accuracy
+from .diagnostics import call_user, warn_accuracy
 
 __all__ = ["PolyTrajectory", "poly_trajectory", "feedforward", "OpenLoopPlan", "open_loop_control",
            "plot_plan"]
@@ -34,6 +34,20 @@ __all__ = ["PolyTrajectory", "poly_trajectory", "feedforward", "OpenLoopPlan", "
 def _times(t, name: str = "t"):
     """Return (times as a 1-D array, whether the input was a single number)."""
     return as_vector(t, name), np.ndim(t) == 0
+
+
+def _input_time(t, horizon: float) -> float:
+    """One time for a plan's ``input(t, x)``, clipped to [0, T]; checked unless a finite float.
+
+    An ODE solver passes a finite float at every step, so that case skips the checks.
+    """
+    tt = t if isinstance(t, float) and isfinite(t) else as_scalar(t, "t")
+    return min(max(tt, 0.0), horizon)
+
+
+def _plan_grid(horizon: float, samples) -> np.ndarray:
+    """The plot grid of a plan: `samples` (>= 2) times on [0, T]."""
+    return time_grid(horizon, samples, t_end_name="T")
 
 
 def _derivative_order(k) -> int:
@@ -294,7 +308,7 @@ def _check_trajectory(traj) -> None:
             f"traj must be a function traj(t, k) returning the k-th derivative of y_d at t: "
             f"received {type(traj).__name__}; build one with poly_trajectory(T, start, end)."
         )
-    value = np.asarray(traj(0.0, 0), dtype=float)
+    value = call_user(traj, (0.0, 0), "traj", where="at t = 0 (k = 0), called once as a check")
     if value.size != 1:
         raise ValueError(
             f"traj(0.0, 0) returned shape {value.shape}; expected one number (the desired output y_d(0))."
@@ -310,6 +324,9 @@ def feedforward(a, b, traj: Callable) -> Callable:
     output and its derivatives, e.g. a `poly_trajectory`.
 
     Returns ``ud(t)``: a number for a number, an array for an array of times.
+    A `traj` that raises, or returns NaN/inf, text or None (checked once at
+    t = 0 and at every call of ``ud``) gives a `UserFunctionError` (a
+    ValueError) naming traj and the derivative asked for.
     """
     a = as_vector(a, "a")
     b = as_scalar(b, "b")
@@ -319,11 +336,15 @@ def feedforward(a, b, traj: Callable) -> Callable:
     _check_trajectory(traj)
     n = a.size
 
+    def y(t, k):
+        value = call_user(traj, (t, k), "traj", where=f"for the derivative k = {k} in feedforward's ud(t)")
+        return value[()] if value.ndim == 0 else value
+
     def ud(t):
         # (2.25): u_d = (1/b) [a_0 y_d + ... + a_{n-1} y_d^(n-1) + y_d^(n)]
-        total = traj(t, n)
+        total = y(t, n)
         for i in range(n):
-            total = total + a[i] * traj(t, i)
+            total = total + a[i] * y(t, i)
         return total / b
 
     return ud
@@ -386,8 +407,7 @@ class OpenLoopPlan:
 
     def input(self, t, x=None) -> np.ndarray:
         """``u(t, x)`` for `simulate`: the open-loop input ignores x (t is clipped to [0, T])."""
-        tt = min(max(float(t), 0.0), self.horizon)
-        return np.array(self._input_derivatives(tt, 1))
+        return np.array(self._input_derivatives(_input_time(t, self.horizon), 1))
 
     def _input_derivatives(self, t: float, count: int) -> list:
         """[u_d, u_d', ..., u_d^(count-1)] at one time t, in plain floats.
@@ -407,7 +427,7 @@ class OpenLoopPlan:
 
     def plot(self, samples: int = 301):
         """Figure of the planned states x(t) and the input u_d(t) on [0, T]; returns the figure."""
-        t = np.linspace(0.0, self.horizon, int(as_scalar(samples, "samples", positive=True, integer=True)))
+        t = _plan_grid(self.horizon, samples)
         return plot_plan(t, self.x(t), self.ud(t).reshape(-1, 1),
                          title=f"open-loop plan (2.73) from x0 = {self.x0.tolist()} to xT = {self.xT.tolist()}")
 
@@ -532,12 +552,10 @@ def open_loop_control(A, B, x0, xT, T, *, smooth: int = 0) -> OpenLoopPlan:
     x0 = as_vector(x0, "x0", size=n, why=why)
     xT = as_vector(xT, "xT", size=n, why=why)
     horizon = as_scalar(T, "T", positive=True)
-    extra = as_scalar(smooth, "smooth", integer=True)
-    if extra < 0:
-        raise ValueError(f"smooth must be >= 0: received {smooth!r} (the number of extra zero derivatives).")
+    extra = as_integer(smooth, "smooth", minimum=0, why="the number of extra zero derivatives")
     Tz = ccf_transform(A, B)
     a = charpoly(A)
-    zeros = np.zeros(int(extra))
+    zeros = np.zeros(extra)
     # z0 = T x0, zT = T xT; in the CCF z = [z1, z1', ..., z1^(n-1)]
     yd = poly_trajectory(horizon, np.concatenate([Tz @ x0, zeros]), np.concatenate([Tz @ xT, zeros]))
     plan = OpenLoopPlan(A, B, x0, xT, horizon, Tz, a, yd)

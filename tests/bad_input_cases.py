@@ -146,13 +146,20 @@ def scalar_cases(target: str, arg: str, build: Callable, good=1.0, *, positive=F
         bad(target, f"{arg} {label}", lambda value=value: build(value), arg)
 
 
-def poles_cases(target: str, arg: str, build: Callable, good) -> None:
-    """Good control plus wrong count, lone complex pole, NaN, inf, None, text, empty."""
+def poles_cases(target: str, arg: str, build: Callable, good, *, any_count: bool = False) -> None:
+    """Good control plus wrong count, lone complex pole, NaN, inf, None, text, empty.
+
+    `any_count`: the function takes any number of poles (no count is wrong), so
+    one more and one fewer are good controls instead of bad cases.
+    """
     good = list(good)
     ok(target, f"{arg} good", lambda: build(good))
     lone = [complex(good[0].real if isinstance(good[0], complex) else good[0], 1.0)] + good[1:]
-    for label, value in {"one too many": good + [-7.0], "one too few": good[:-1],
-                         "complex without conjugate": lone, "NaN": [np.nan] + good[1:],
+    counts = {"one too many": good + [-7.0], "one too few": good[:-1]}
+    for label, value in counts.items():
+        (ok if any_count else bad)(target, f"{arg} {label}", lambda value=value: build(value),
+                                   *(() if any_count else (arg,)))
+    for label, value in {"complex without conjugate": lone, "NaN": [np.nan] + good[1:],
                          "inf": [-np.inf] + good[1:], "None": None, "text": "-1, -2",
                          "empty": []}.items():
         bad(target, f"{arg} {label}", lambda value=value: build(value), arg)
@@ -461,7 +468,8 @@ for _name, _fn in (("place", ck.place), ("place_details", ck.place_details)):
     bad(_name, "uncontrollable", lambda _fn=_fn: _fn(A_UNCTRL, B_UNCTRL, P2), "B")
 ok("place", "complex pair", lambda: ck.place(A2, B2, [-1 + 1j, -1 - 1j]))
 ok("PlacementDetails", "fields", lambda: ck.place_details(A2, B2, P2).K)
-poles_cases("poly_from_roots", "poles", ck.poly_from_roots, P2)
+# the degree of the polynomial is the number of roots: no count is wrong, only none at all
+poles_cases("poly_from_roots", "poles", ck.poly_from_roots, P2, any_count=True)
 for _name, _fn in (("is_stable", ck.is_stable), ("stability_margin", ck.stability_margin)):
     matrix_cases(_name, "A", _fn, A2)
     scalar_cases(_name, "dt", lambda dt, _fn=_fn: _fn(A2, dt=dt), 0.1, positive=True, optional=True)

@@ -87,7 +87,27 @@ def test_nan_residuals_never_make_an_equilibrium():
     with pytest.raises(ck.UserFunctionError, match=r"f \(nan_torque\) returned NaN or inf at x = "
                                                    r"\[0.3, 0.0\], u = \[0.0\]"):
         ck.equilibrium_input(nan_torque, [0.3, 0.0], m=1)
-    assert ck.find_equilibria(nan_torque, [0.0], [[0.3, 0.0], [1.0, 0.0]]).shape == (0, 2)
+    # NaN at every starting point leaves nothing to search from: an error, not an empty result
+    with pytest.raises(ck.UserFunctionError, match=r"f \(nan_torque\) returned NaN or inf at every "
+                                                   r"one of the 2 starting points"):
+        ck.find_equilibria(nan_torque, [0.0], [[0.3, 0.0], [1.0, 0.0]])
+
+    def nan_at_root(x, u):  # finite at the guess, NaN where the solver lands (x = 1)
+        return np.where(np.abs(x - 1.0) < 0.1, np.nan, x - 1.0)
+
+    assert ck.find_equilibria(nan_at_root, None, [[3.0]]).shape == (0, 1)
+
+
+def test_bare_function_sizes_are_checked_before_solving():
+    # n is read off the guesses' columns: a mismatch with f names both
+    with pytest.raises(ValueError, match=r"returned 1 numbers .* expected 2.*guesses has one column"):
+        ck.find_equilibria(lambda x, u: x[:1], None, [[0.5, 0.0]])
+    with pytest.raises(ValueError, match=r"returned 3 numbers at x_eq = \[0.0, 0.0\]; expected 2"):
+        ck.equilibrium_input(lambda x, u: np.zeros(3), [0.0, 0.0], m=1)
+    # without m, the length of u_guess gives the number of inputs: u* = 9.81 sin(0.3) holds 0.3 rad
+    u = ck.equilibrium_input(lambda x, u: np.array([x[1], -9.81 * np.sin(x[0]) + u[0]]),
+                             [0.3, 0.0], u_guess=[1.0])
+    np.testing.assert_allclose(u, [9.81 * np.sin(0.3)], rtol=1e-12)  # f is linear in u: the solver lands to rounding
 
 
 def test_a_model_undefined_at_some_guesses_still_finds_the_others():

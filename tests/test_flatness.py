@@ -141,6 +141,19 @@ def test_flatness_bad_input():
         ck.plan_robot([0, 0], [1, 1, 0], 1.0)
     with pytest.raises(ValueError, match=r"L must be positive"):
         ck.car_like_flatness(L=0)
+    # a truthy string used to mean "reverse"
+    with pytest.raises(ValueError, match=r"reverse must be True or False: received str 'no'"):
+        ck.two_wheeled_flatness(reverse="no")
+    # complex boundary data were cast to real with numpy's ComplexWarning only
+    with pytest.raises(ValueError, match=r"start must contain real numbers"):
+        ck.plan_flat_output(flat, 1.0, np.array([0.0, 0.0]) + 0j, [1, 0])
+    with pytest.raises(ValueError, match=r"x must contain real numbers"):
+        flat.phi([0.1 + 1j, 0.0])
+    plan = ck.plan_flat_output(flat, 1.0, [0, 0], [1, 0])
+    with pytest.raises(ValueError, match=r"\bt must contain real numbers"):
+        plan.input("0.5")
+    with pytest.raises(ValueError, match=r"samples must be at least 2"):
+        plan.plot(samples=1)
 
 
 # ---- the planners check their boundary states (issue 14) ----------------------------------

@@ -83,6 +83,20 @@ def test_symbolic_jacobian_3_69_and_3_83():
         ck.symbolic_jacobian(f, [1, 2])
     with pytest.raises(ValueError, match="x_eq has the wrong length"):
         ck.linearize_symbolic(f, [x1, x2], [u], [0], [0])
+    # a complex equilibrium used to be substituted into A (a real system has real equilibria)
+    with pytest.raises(ValueError, match="x_eq must contain real values"):
+        ck.linearize_symbolic(f, [x1, x2], [u], [1j, 0], [0])
+    with pytest.raises(ValueError, match="u_eq must contain real values"):
+        ck.linearize_symbolic(f, [x1, x2], [u], [0, 0], [sp.I])
+    with pytest.raises(ValueError, match="f must be a list of sympy expressions: received the text"):
+        ck.linearize_symbolic("x2", [x1, x2], x_eq=[0, 0])
+
+
+def test_linearize_checks_tol():
+    # tol = NaN made every equilibrium check fail with a misleading "not an equilibrium"
+    for tol in (np.nan, -1.0, "1e-8"):
+        with pytest.raises(ValueError, match=r"\btol\b"):
+            ck.linearize(lambda x, u: -x, [0.0], tol=tol)
 
 
 @given(st.integers(1, 5), st.integers(1, 3), st.integers(0, 10_000))

@@ -330,6 +330,7 @@ def test_cart_pole_in_si_units():
     ([-1, np.inf], r"poles contains NaN or infinite"),
     ([-1 + 1j, -2], r"without its conjugate"),
     ("ab", r"poles must be a list of numbers"),
+    ([], r"poles is empty"),
 ])
 def test_poly_from_roots_rejects_bad_poles(poles, message):
     with pytest.raises(ValueError, match=message):
@@ -339,6 +340,8 @@ def test_poly_from_roots_rejects_bad_poles(poles, message):
 def test_poly_from_roots_values():
     np.testing.assert_allclose(ck.poly_from_roots([-1 + 2j, -1 - 2j]), [5, 2])   # s^2 + 2 s + 5
     np.testing.assert_allclose(ck.poly_from_roots(-2), [2])
+    # any number of roots: the degree is their count (s + 1)(s + 2)(s + 3) = s^3 + 6 s^2 + 11 s + 6
+    np.testing.assert_allclose(ck.poly_from_roots([-1, -2, -3]), [6, 11, 6])
 
 
 # ------------------------------------------------------------------------------------------

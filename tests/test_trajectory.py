@@ -99,6 +99,33 @@ def test_feedforward_bad_input():
         ck.feedforward([1.0, 2.0], 1.0, lambda t, k: np.zeros(2))
 
 
+def test_feedforward_names_traj_when_it_fails_after_the_first_check():
+    # fine at t = 0 (the check at construction), NaN from t = 1 on, raising from t = 2 on
+    def traj(t, k=0):
+        t = np.asarray(t, dtype=float)
+        if np.any(t >= 2.0):
+            raise KeyError("beyond the table")
+        return np.where(t < 1.0, 0.0, np.nan)
+
+    ud = ck.feedforward([2.0, 3.0], 1.0, traj)
+    assert ud(0.5) == 0.0
+    with pytest.raises(ck.UserFunctionError, match=r"traj returned NaN or inf for the derivative k = 2"):
+        ud(np.array([0.5, 1.5]))
+    with pytest.raises(ck.UserFunctionError, match=r"traj raised KeyError for the derivative k = 2"):
+        ud(2.5)
+
+
+def test_plan_input_checks_a_time_that_is_not_a_float():
+    plan = ck.open_loop_control([[0, 1], [-2, -3]], [[0], [1]], [0, 0], [1, 0], 2.0)
+    # an int time is converted (to the same float 1.0, so the same arithmetic and bits),
+    # a text time refused (float("1") used to accept it)
+    np.testing.assert_allclose(plan.input(1), plan.input(1.0), rtol=0, atol=0)
+    with pytest.raises(ValueError, match=r"\bt must contain real numbers"):
+        plan.input("1")
+    with pytest.raises(ValueError, match=r"samples must be at least 2"):
+        plan.plot(samples=1)
+
+
 # ---- open-loop control for a general LTI system (2.73) -------------------------------------
 
 def test_example_2_66_end_to_end():
@@ -169,7 +196,7 @@ def test_open_loop_control_errors():
         ck.open_loop_control([[0, 1], [0, 0]], [[0], [1]], [0, 0], [1, 1], -1.0)
     with pytest.raises(ValueError, match=r"B must have a single column"):
         ck.open_loop_control(np.eye(2), np.eye(2), [0, 0], [1, 1], 1.0)
-    with pytest.raises(ValueError, match=r"smooth must be >= 0"):
+    with pytest.raises(ValueError, match=r"smooth must be at least 0"):
         ck.open_loop_control([[0, 1], [0, 0]], [[0], [1]], [0, 0], [1, 1], 1.0, smooth=-1)
 
 
