@@ -253,6 +253,9 @@ def as_poles(poles, name: str = "poles", *, count: int) -> np.ndarray:
     Complex poles must come with their conjugate, otherwise no real gain can
     place them.
     """
+    if poles is None:
+        raise ValueError(f"{name} is missing: received None; pass the poles as a list of numbers, "
+                         "e.g. [-1, -2].")
     try:
         arr = np.atleast_1d(np.asarray(poles, dtype=complex)).ravel()
     except (TypeError, ValueError):
