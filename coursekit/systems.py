@@ -108,6 +108,27 @@ def _evaluate(func: Callable, x: np.ndarray, u: np.ndarray, name: str) -> np.nda
     return call_user(func, (x, u), name, where=_at(x, u))
 
 
+def _raw_field(sys) -> Callable:
+    """The model's own f(x, u), without the argument checks and the wrapping of `sys.f`.
+
+    For hot loops (`simulate`) and for callers that call it through
+    `call_user` with context of their own ("at t = 0.4"); calling `sys.f`
+    there would wrap an already explained `UserFunctionError` once more.
+    """
+    if isinstance(sys, StateSpace):
+        A, B = sys.A, sys.B
+        return lambda x, u: A @ x + B @ u
+    return sys._f
+
+
+def _raw_output(sys) -> Callable:
+    """The model's own h(x, u) (C x + D u, or x when h is not given), as `_raw_field` for f."""
+    if isinstance(sys, StateSpace):
+        C, D = sys.C, sys.D
+        return lambda x, u: C @ x + D @ u
+    return sys._h or (lambda x, u: np.array(x, dtype=float))
+
+
 class StateSpace:
     """A linear time-invariant system in state-space form (1.24).
 
