@@ -194,3 +194,19 @@ def test_lti_step_matrices_accept_a_flat_b_and_match_the_exponential():
     # a constant input: B0 + B1 is the zero-order-hold integral A^-1 (e^(A h) - I) B
     np.testing.assert_allclose(B0 + B1, np.linalg.solve(A, expm(0.1 * A) - np.eye(2)) @ [[0.0], [1.0]],
                                rtol=1e-12, atol=1e-14)
+
+
+@pytest.mark.parametrize("sys", [PLANT, PEND, ck.NonlinearSystem(lambda x, u: -x, n=2, m=1)],
+                         ids=["StateSpace", "NonlinearSystem", "default h"])
+def test_raw_field_and_output_are_f_and_h_without_the_wrapping(sys):
+    from coursekit.systems import _raw_field, _raw_output
+    x, u = np.array([0.3, -0.2]), np.array([0.5])
+    # the same operations on the same numbers: equal to rounding
+    np.testing.assert_allclose(_raw_field(sys)(x, u), sys.f(x, u), rtol=1e-15, atol=0)
+    np.testing.assert_allclose(np.ravel(_raw_output(sys)(x, u)), sys.h(x, u), rtol=1e-15, atol=0)
+
+
+def test_raw_field_lets_the_users_own_exception_through():
+    from coursekit.systems import _raw_field
+    with pytest.raises(ZeroDivisionError):
+        _raw_field(ck.NonlinearSystem(_raises, n=2, m=1))(np.zeros(2), np.zeros(1))
