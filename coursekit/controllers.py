@@ -45,16 +45,22 @@ def _gain(K, name: str = "K") -> np.ndarray:
     return as_matrix(K, name, rows=1 if np.ndim(K) == 1 else None)
 
 
-def _states(x, n: int, name: str = "x") -> np.ndarray:
-    """x as one state (n,) or a batch (n, k) of states as columns; other shapes raise
-    ValueError (a row (1, n) or a wrong length would broadcast into a wrong answer)."""
+def _states(x, n: int, name: str = "x", gain: str = "") -> np.ndarray:
+    """x as one state (n,) or a batch (n, k) of states as columns (a column (n, 1) is a
+    batch of one); other shapes raise ValueError (a row (1, n) or a wrong length would
+    broadcast into a wrong answer), which names `gain` ("K is 1x3") when given."""
     x = np.asarray(x)
     if x.dtype.kind != "f":
         x = _float_array(x, name)
     if x.ndim not in (1, 2) or x.shape[0] != n:
-        raise ValueError(f"{name} has shape {x.shape}: expected ({n},), one entry per state, "
+        since = f", since {gain}" if gain else ""
+        raise ValueError(f"{name} has shape {x.shape}: expected ({n},), one entry per state{since}, "
                          f"or ({n}, k) for a batch of k states as columns.")
     return x
+
+
+def _size(name: str, M: np.ndarray) -> str:
+    return f"{name} is {M.shape[0]}x{M.shape[1]}"
 
 
 def _column(v: np.ndarray, x: np.ndarray) -> np.ndarray:
@@ -66,7 +72,8 @@ class StateFeedback:
     """u = K (x - x*) + u*: linear state feedback around an equilibrium (3.92), (3.100).
 
     Call it as ``controller(t, x)`` (the signature `simulate` expects); with
-    x a batch (n, k) of states it returns (m, k), as `simulate_batch` expects.
+    x a batch (n, k) of states it returns (m, k), as `simulate_batch` expects
+    (a column x (n, 1) is a batch of one and gives a column u (m, 1)).
     For a nonlinear plant, K comes from the linearization at (x*, u*)
     (3.88)-(3.91) and the law only works near x*; for a linear plant
     x' = A x + B u with A x* + B u* = 0 (3.94) it works globally (3.98)-(3.100).
@@ -82,7 +89,7 @@ class StateFeedback:
 
     def __call__(self, t, x) -> np.ndarray:
         # x: one state (n,), or a batch (n, k) as `simulate_batch` passes it
-        x = _states(x, self.K.shape[1])
+        x = _states(x, self.K.shape[1], gain=_size("K", self.K))
         if x.ndim == 2:
             return self.K @ (x - self.x_eq[:, None]) + self.u_eq[:, None]
         # (3.92): u = K (x - x*) + u*
@@ -137,7 +144,7 @@ class TrackingController:
         self.u_d = _trajectory(u_d, "u_d", m, f"the open-loop input, {m} numbers")
 
     def __call__(self, t, x) -> np.ndarray:
-        x = _states(x, self.K.shape[1])
+        x = _states(x, self.K.shape[1], gain=_size("K", self.K))
         t = as_scalar(t, "t")
         # (3.104): u = K (x - x_d(t)) + u_d(t)
         return self.K @ (x - _column(self.x_d(t), x)) + _column(self.u_d(t), x)
@@ -215,7 +222,7 @@ class IntegralFeedback:
 
     def __call__(self, t, x_E) -> np.ndarray:
         # x_E: one augmented state (N,) or a batch (N, k)
-        x_E = _states(x_E, self.K_E.shape[1], "x_E")
+        x_E = _states(x_E, self.K_E.shape[1], "x_E", _size("K_E", self.K_E))
         # (3.110)/(3.125): u = K x + K_I * integral
         return self.K_E @ x_E
 

@@ -36,7 +36,7 @@ import numpy as np
 
 from ._validation import as_matrix, as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
 from .diagnostics import UserFunctionError, call_user
-from .systems import NonlinearSystem, StateSpace, _checked_call
+from .systems import NonlinearSystem, StateSpace, _checked_call, _raw_field
 
 __all__ = ["simulate", "simulate_batch", "SimulationResult", "SimulationError", "lti_step_matrices"]
 
@@ -434,16 +434,6 @@ class _Model:
         if _out_of_range(xk):
             raise _overflow(self.sys, f"the state reached {np.array2string(np.asarray(xk), precision=3)} "
                             f"at t = {tk:.6g}", feedback=self.u_user is not None)
-
-
-def _raw_field(sys) -> Callable:
-    """f(x, u) for the hot loops, without the argument checks and the conversion of
-    `sys.f` (the solver's x and the checked u have the right shapes by construction;
-    the callers convert and check the value)."""
-    if isinstance(sys, StateSpace):
-        A, B = sys.A, sys.B
-        return lambda x, u: A @ x + B @ u
-    return sys._f
 
 
 def _out_of_range(x) -> bool:

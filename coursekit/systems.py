@@ -38,7 +38,9 @@ def _checked_call(func: Callable, args: tuple, name: str, *, size: int, what: st
 
 
 def _float_array(value, name: str) -> np.ndarray:
-    """value as a float array; complex or non-numeric values raise ValueError naming `name`."""
+    """value as a float array; None, complex or non-numeric values raise ValueError naming `name`."""
+    if value is None:
+        raise ValueError(f"{name} is None: expected an array of real numbers.")
     arr = np.asarray(value)
     if arr.dtype.kind == "f":
         return arr
@@ -51,27 +53,80 @@ def _float_array(value, name: str) -> np.ndarray:
                          f"({err}).") from None
 
 
+def _finite(arr: np.ndarray, name: str) -> np.ndarray:
+    """arr itself; NaN or inf entries raise ValueError naming `name`."""
+    if not np.isfinite(arr).all():
+        raise ValueError(f"{name} contains NaN or inf: {np.array2string(arr, precision=4)}; "
+                         f"pass finite numbers (a NaN usually comes from an earlier computation).")
+    return arr
+
+
 def _state_and_input(x, u, n: int, m: int) -> tuple[np.ndarray, np.ndarray]:
     """x of shape (n,) or a batch (n, ...) of states, u of shape (m,) or (m, ...) to match.
 
     Raises ValueError naming x or u and the expected shape: a column x (n, 1)
-    with a flat u (m,) would otherwise broadcast into an (n, n) result.
-    With m = 0, u may be None or empty.
+    is a batch of one state and needs u of shape (m, 1) (with a flat u (m,)
+    it would otherwise broadcast into an (n, n) result). NaN/inf entries and
+    u = None raise ValueError too; with m = 0, u may be None or empty.
     """
-    x = _float_array(x, "x")
+    x = _finite(_float_array(x, "x"), "x")
     if x.ndim == 0 or x.shape[0] != n:
         raise ValueError(f"x has shape {x.shape}: expected ({n},), one entry per state, or ({n}, k) "
                          "for a batch of k states as columns.")
     batch = x.shape[1:]
     if m == 0 and (u is None or np.size(u) == 0):
         return x, np.zeros((0,) + batch)
-    u = _float_array(u, "u")
+    u = _finite(_float_array(u, "u"), "u")
     if x.ndim == 1 and u.size == m and u.ndim <= 1:
         return x, u.reshape(m)
     if u.shape != (m,) + batch:
         raise ValueError(f"u has shape {u.shape}: expected {(m,) + batch} for x of shape {x.shape} "
                          f"(one entry per input{', one column per state of the batch' if batch else ''}).")
     return x, u
+
+
+def _at(x: np.ndarray, u: np.ndarray) -> str:
+    """'at x = [1. 0.], u = [0.]' (the shapes, for a batch): where f or h was called."""
+    if x.ndim > 1:
+        return f"on the batch of states x of shape {x.shape} (u of shape {u.shape})"
+    return f"at x = {np.array2string(x, precision=6)}, u = {np.array2string(u, precision=6)}"
+
+
+def _evaluate(func: Callable, x: np.ndarray, u: np.ndarray, name: str) -> np.ndarray:
+    """func(x, u) as a float array of the shape func returns.
+
+    Fast path: finite real numbers are returned at once. Anything else (an
+    exception, None, complex, NaN/inf, not numbers) repeats the call through
+    `call_user`, whose `UserFunctionError` names `name` and the point (x, u).
+    """
+    try:
+        value = np.asarray(func(x, u))
+        if value.dtype.kind in "fiu" and np.isfinite(value).all():
+            return value.astype(float, copy=False)
+    except Exception:  # explained below, by the repeated call
+        pass
+    return call_user(func, (x, u), name, where=_at(x, u))
+
+
+def _raw_field(sys) -> Callable:
+    """The model's own f(x, u), without the argument checks and the wrapping of `sys.f`.
+
+    For hot loops (`simulate`) and for callers that call it through
+    `call_user` with context of their own ("at t = 0.4"); calling `sys.f`
+    there would wrap an already explained `UserFunctionError` once more.
+    """
+    if isinstance(sys, StateSpace):
+        A, B = sys.A, sys.B
+        return lambda x, u: A @ x + B @ u
+    return sys._f
+
+
+def _raw_output(sys) -> Callable:
+    """The model's own h(x, u) (C x + D u, or x when h is not given), as `_raw_field` for f."""
+    if isinstance(sys, StateSpace):
+        C, D = sys.C, sys.D
+        return lambda x, u: C @ x + D @ u
+    return sys._h or (lambda x, u: np.array(x, dtype=float))
 
 
 class StateSpace:
@@ -145,8 +200,9 @@ class StateSpace:
         """Right-hand side A x + B u (dx/dt, or x(t+1) in discrete time) (1.24).
 
         x is (n,) and u (m,), or a batch: x (n, k) and u (m, k), states and
-        inputs as columns, giving (n, k). Other shapes raise ValueError
-        (u may be None or empty when m = 0).
+        inputs as columns, giving (n, k); a column x (n, 1) is a batch of one
+        and needs u (m, 1). Other shapes, None or NaN/inf raise ValueError
+        naming x or u (u may be None or empty when m = 0).
         """
         x, u = _state_and_input(x, u, self.n, self.m)
         return self._apply(self.A, self.B, x, u)
@@ -227,18 +283,20 @@ class NonlinearSystem:
         """Evaluate the vector field f(x, u).
 
         x is (n,) and u (m,), or a batch (n, ...) and (m, ...) for a
-        function written on the rows x[0], x[1], ...; other shapes raise
-        ValueError naming x or u (u may be None or empty when m = 0).
+        function written on the rows x[0], x[1], ...; other shapes, None or
+        NaN/inf raise ValueError naming x or u (u may be None or empty when
+        m = 0). When the user's f raises, or returns None, complex numbers
+        or NaN/inf, `UserFunctionError` (a ValueError) names f and the point.
         """
         x, u = _state_and_input(x, u, self.n, self.m)
-        return np.asarray(self._f(x, u), dtype=float)
+        return _evaluate(self._f, x, u, "f")
 
     def h(self, x, u) -> np.ndarray:
-        """Evaluate the output map h(x, u) (x itself by default); shapes as in `f`."""
+        """Evaluate the output map h(x, u) (x itself by default); shapes and errors as in `f`."""
         x, u = _state_and_input(x, u, self.n, self.m)
         if self._h is None:
             return x.copy()
-        return np.atleast_1d(np.asarray(self._h(x, u), dtype=float))
+        return np.atleast_1d(_evaluate(self._h, x, u, "h"))
 
     def output_size(self, x, u) -> int:
         """Number of outputs, found by evaluating h once at (x, u)."""

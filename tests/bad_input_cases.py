@@ -223,6 +223,13 @@ def _sym_msd():
     return ck.symbolic_mass_spring_damper()
 
 
+def _column_u(u):
+    """u = K2 [1, 1]^T + 1 = -2 as a column (1, 1); anything else fails the case."""
+    if np.shape(u) != (1, 1) or not np.isclose(u[0, 0], -2.0, rtol=0, atol=1e-12):  # exact in floats
+        raise AssertionError(f"expected the column [[-2.]], received {u!r}")
+    return u
+
+
 def result():
     return ck.simulate(sys2(), T11, u=np.ones((11, 1)))
 
@@ -518,7 +525,8 @@ bad("linearize_symbolic", "x_eq wrong length", lambda: ck.linearize_symbolic(_sy
 bad("linearize_symbolic", "x_eq complex", lambda: ck.linearize_symbolic(_sym_f()[0], _sym_f()[1], x_eq=[1j, 0]), "x_eq")
 
 matrix_cases("StateFeedback", "K", lambda K: ck.StateFeedback(K)(0.0, np.zeros(2)), K2, shape=np.ones((1, 3)), empty=False)
-bad("StateFeedback", "x column with flat u_eq", lambda: ck.StateFeedback(K2, u_eq=[0.0])(0.0, np.zeros((2, 1))), "x")
+# a column x (n, 1) is a batch of one state (as in simulate_batch): u is the column K x + u* (m, 1)
+ok("StateFeedback", "x column with flat u_eq", lambda: _column_u(ck.StateFeedback(K2, u_eq=[1.0])(0.0, np.ones((2, 1)))))
 bad("StateFeedback", "x wrong length", lambda: ck.StateFeedback(K2)(0.0, np.zeros(3)), "x")
 bad("StateFeedback", "x complex", lambda: ck.StateFeedback(K2)(0.0, np.zeros(2) + 1j), "x")
 bad("StateFeedback", "x_eq wrong length", lambda: ck.StateFeedback(K2, x_eq=[0.0, 0.0, 0.0]), "x_eq")

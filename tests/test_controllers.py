@@ -181,8 +181,9 @@ def _controllers():
 @pytest.mark.parametrize("ctrl", _controllers(), ids=lambda c: type(c).__name__)
 def test_controllers_reject_a_misshaped_state(ctrl, bad):
     # a row (1, 2) used to broadcast against x_eq into a (1, 2) answer, silently
-    with pytest.raises(ValueError, match=r"x(_E)? has shape .*: expected \(2,\), one entry per state, "
-                                         r"or \(2, k\) for a batch"):
+    # the gain's size is named when there is one ("since K is 1x2")
+    with pytest.raises(ValueError, match=r"x(_E)? has shape .*: expected \(2,\), one entry per state"
+                                         r"(, since K(_E)? is 1x2)?, or \(2, k\) for a batch"):
         ctrl(0.3, bad)
 
 

@@ -123,6 +123,54 @@ def test_check_names_where_f_or_h_fail():
         sys.check(np.array([0.0]), np.zeros(0), where="at x0")
 
 
+@pytest.mark.parametrize("sys", [PLANT, PEND], ids=["StateSpace", "NonlinearSystem"])
+@pytest.mark.parametrize("x, u, message", [
+    ([np.nan, 0.0], [0.0], r"x contains NaN or inf"),
+    ([0.0, np.inf], [0.0], r"x contains NaN or inf"),
+    ([0.0, 0.0], [np.nan], r"u contains NaN or inf"),
+    ([0.0, 0.0], None, r"u is None: expected an array of real numbers"),
+])
+def test_f_and_h_refuse_nan_states_and_a_missing_input(sys, x, u, message):
+    # NaN used to pass through A x + B u, and u = None became NaN
+    for method in (sys.f, sys.h):
+        with pytest.raises(ValueError, match=message):
+            method(x, u)
+
+
+def _raises(x, u):
+    raise ZeroDivisionError("student's bug")
+
+
+@pytest.mark.parametrize("bad, message", [
+    (_raises, r"raised ZeroDivisionError at x = \[1\. 2\.\], u = \[0\.5\].*student's bug"),
+    (lambda x, u: None, r"returned None at x = \[1\. 2\.\], u = \[0\.5\]"),
+    (lambda x, u: x + 1j, r"returned complex numbers at x = \[1\. 2\.\]"),
+    (lambda x, u: x / 0.0, r"returned NaN or inf at x = \[1\. 2\.\]"),
+    (lambda x, u: ["a", "b"], r"returned list.*not an array of real numbers"),
+])
+def test_f_and_h_name_the_user_function_that_fails_and_the_point(bad, message):
+    good = lambda x, u: np.array([x[1], u[0]])                                   # noqa: E731
+    x, u = np.array([1.0, 2.0]), np.array([0.5])
+    with np.errstate(divide="ignore"):
+        with pytest.raises(ck.UserFunctionError, match="f " + message):
+            ck.NonlinearSystem(bad, n=2, m=1, h=good).f(x, u)
+        with pytest.raises(ck.UserFunctionError, match="h " + message):
+            ck.NonlinearSystem(good, n=2, m=1, h=bad).h(x, u)
+
+
+def test_nonlinear_f_and_h_keep_batches_and_plain_lists():
+    # a batch (n, k, 5) as the chapter 2 explorer passes it: rows in, rows out, unchanged
+    sys = ck.NonlinearSystem(lambda x, u: [x[1], -x[0] + u[0]], n=2, m=1, h=lambda x, u: x[0] * 2)
+    X = np.arange(30.0).reshape(2, 3, 5)
+    U = np.ones((1, 3, 5))
+    np.testing.assert_array_equal(sys.f(X, U), np.stack([X[1], -X[0] + 1.0]))   # exact: one operation
+    np.testing.assert_array_equal(sys.h(X, U), 2 * X[0])
+    assert sys.f([1.0, 2.0], [0.0]).dtype == float
+    with np.errstate(all="ignore"), pytest.raises(
+            ck.UserFunctionError, match=r"f returned NaN or inf on the batch of states x of shape \(2, 3, 5\)"):
+        ck.NonlinearSystem(lambda x, u: x / 0.0, n=2, m=1).f(X, U)
+
+
 @pytest.mark.parametrize("args, message", [
     (([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], [[1.0], [1.0]], 0.1), r"A must be square"),
     ((np.eye(2), np.ones((3, 1)), 0.1), r"B has the wrong number of rows: received shape \(3, 1\), expected 2"),
@@ -146,3 +194,19 @@ def test_lti_step_matrices_accept_a_flat_b_and_match_the_exponential():
     # a constant input: B0 + B1 is the zero-order-hold integral A^-1 (e^(A h) - I) B
     np.testing.assert_allclose(B0 + B1, np.linalg.solve(A, expm(0.1 * A) - np.eye(2)) @ [[0.0], [1.0]],
                                rtol=1e-12, atol=1e-14)
+
+
+@pytest.mark.parametrize("sys", [PLANT, PEND, ck.NonlinearSystem(lambda x, u: -x, n=2, m=1)],
+                         ids=["StateSpace", "NonlinearSystem", "default h"])
+def test_raw_field_and_output_are_f_and_h_without_the_wrapping(sys):
+    from coursekit.systems import _raw_field, _raw_output
+    x, u = np.array([0.3, -0.2]), np.array([0.5])
+    # the same operations on the same numbers: equal to rounding
+    np.testing.assert_allclose(_raw_field(sys)(x, u), sys.f(x, u), rtol=1e-15, atol=0)
+    np.testing.assert_allclose(np.ravel(_raw_output(sys)(x, u)), sys.h(x, u), rtol=1e-15, atol=0)
+
+
+def test_raw_field_lets_the_users_own_exception_through():
+    from coursekit.systems import _raw_field
+    with pytest.raises(ZeroDivisionError):
+        _raw_field(ck.NonlinearSystem(_raises, n=2, m=1))(np.zeros(2), np.zeros(1))
