@@ -16,7 +16,7 @@ import numpy as np
 from ._validation import as_integer, as_matrix, as_scalar, as_vector
 from .diagnostics import UserFunctionError, call_user
 from .linearization import _function_name, _sympy_column
-from .systems import NonlinearSystem, StateSpace
+from .systems import NonlinearSystem, StateSpace, _raw_field
 
 __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
 
@@ -24,7 +24,7 @@ __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
 def _field(f, n=None, dt=None):
     """Return (func, name, n, m or None, dt) for a system or a bare function f(x, u)."""
     if isinstance(f, (NonlinearSystem, StateSpace)):
-        return f.f, _function_name(getattr(f, "_f", f.f)), f.n, f.m, f.dt
+        return _raw_field(f), _function_name(getattr(f, "_f", f.f)), f.n, f.m, f.dt
     if not callable(f):
         raise ValueError(
             f"f must be a NonlinearSystem or a function f(x, u) returning dx/dt: received "

@@ -22,7 +22,7 @@ import numpy as np
 
 from ._validation import _is_complex, as_scalar, as_vector
 from .diagnostics import call_user, warn_accuracy
-from .systems import NonlinearSystem, StateSpace
+from .systems import NonlinearSystem, StateSpace, _raw_field
 
 __all__ = ["linearize", "symbolic_jacobian", "linearize_symbolic"]
 
@@ -42,7 +42,7 @@ def _vector_field(f, x_eq, u_eq):
             u_eq, "u_eq", size=m, why=f"one per input of the system with m={m}")
         if m == 0:
             u = np.zeros(0)
-        return f.f, _function_name(getattr(f, "_f", f.f)), x, u, n, m, dt
+        return _raw_field(f), _function_name(getattr(f, "_f", f.f)), x, u, n, m, dt
     if not callable(f):
         raise ValueError(
             f"f must be a NonlinearSystem or a function f(x, u) returning dx/dt: received "
