@@ -22,10 +22,10 @@ __all__ = ["check_environment", "EnvironmentReport", "MINIMUM_VERSIONS", "find_w
 
 #: lower bounds of pyproject.toml (dependencies and the dev extra); a test keeps them in sync
 MINIMUM_VERSIONS = {
-    "numpy": "1.24",
+    "numpy": "1.25",
     "scipy": "1.10",
     "sympy": "1.12",
-    "matplotlib": "3.7",
+    "matplotlib": "3.8",
     "ipywidgets": "8.0",
     "jupyterlab": "4.0",
 }

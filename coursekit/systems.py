@@ -234,6 +234,30 @@ class StateSpace:
                 parts.append(f"  {label} = {body}")
         return "\n".join(parts)
 
+    # Bridges to python-control and SciPy (coursekit/bridges.py): exact copies of A, B, C, D, dt.
+
+    @classmethod
+    def from_control(cls, sys) -> "StateSpace":
+        """The python-control ``StateSpace`` `sys` as a coursekit StateSpace (dt=0 -> continuous)."""
+        from .bridges import from_control
+        return from_control(sys)
+
+    def to_control(self):
+        """This system as a python-control ``StateSpace`` (continuous -> dt=0; needs `pip install control`)."""
+        from .bridges import to_control
+        return to_control(self)
+
+    @classmethod
+    def from_scipy(cls, sys) -> "StateSpace":
+        """The ``scipy.signal.StateSpace`` `sys` (continuous or discrete) as a coursekit StateSpace."""
+        from .bridges import from_scipy
+        return from_scipy(sys)
+
+    def to_scipy(self):
+        """This system as a ``scipy.signal.StateSpace`` (continuous: dt=None; discrete: its dt)."""
+        from .bridges import to_scipy
+        return to_scipy(self)
+
 
 class NonlinearSystem:
     """A nonlinear system x' = f(x, u), y = h(x, u) (1.32)-(1.33).
