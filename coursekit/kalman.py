@@ -843,8 +843,8 @@ def white_noise(t, intensity, seed=None) -> np.ndarray:
     """
     t = as_time_grid(t, "t")
     dt = _uniform_step(t)
-    W = np.atleast_2d(np.asarray(intensity, dtype=float)) if np.ndim(intensity) < 2 else intensity
-    W = _covariance(W, "intensity", np.shape(W)[0], definite=False)
+    W = as_square(intensity, "intensity")              # a number is 1x1; rejects text, complex
+    W = _covariance(W, "intensity", W.shape[0], definite=False)
     vals, vecs = np.linalg.eigh(W / dt)
     S = vecs * np.sqrt(np.maximum(vals, 0.0))          # S S^T = intensity / dt
     return _rng(seed).standard_normal((t.size, W.shape[0])) @ S.T

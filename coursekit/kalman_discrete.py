@@ -46,7 +46,9 @@ def _sampled_data(sys: StateSpace, y, u):
         return y, np.zeros((N, sys.m))
     if sys.m == 0:
         raise ValueError("u was given, but the system has no input (m = 0); leave u=None.")
-    u = as_series(u, "u", samples=N, channels=sys.m, samples_why="one row per sample of y",
+    u = as_series(u, "u", samples=N, channels=sys.m,
+                  samples_why=f"one row per sample of y, which has {N} rows; u and y must cover the "
+                              "same samples, so check which of them is too short",
                   channels_why="one column per input")
     return y, u
 

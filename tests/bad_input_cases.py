@@ -618,10 +618,9 @@ bad("kalman_bucy", "t decreasing", lambda: _kb(t=T11[::-1]), "t")
 bad("kalman_bucy", "substeps zero", lambda: _kb(substeps=0), "substeps")
 ok("KalmanResult", "sigma", lambda: _kb().sigma)
 
-def _ekf(sys=None, y=None, x0=np.zeros(2), **kw):
+def _ekf(sys=None, y=Y11, x0=np.zeros(2), **kw):
     sysn = pend() if sys is None else sys
-    return ck.extended_kalman_filter(sysn, T11, np.zeros((11, 1)), np.zeros((11, 1)) if y is None else y,
-                                     Q2, R1, np.eye(2), x0, **kw)
+    return ck.extended_kalman_filter(sysn, T11, np.zeros((11, 1)), y, Q2, R1, np.eye(2), x0, **kw)
 
 ok("extended_kalman_filter", "good", _ekf)
 function_cases("extended_kalman_filter", "f", lambda f: _ekf(sys=ck.NonlinearSystem(f, n=2, m=1, h=lambda x, u: x[:1])),
@@ -635,6 +634,27 @@ bad("extended_kalman_filter", "dfdx returns wrong shape", lambda: _ekf(dfdx=lamb
 matrix_cases("extended_kalman_filter", "y", lambda y: _ekf(y=y), np.zeros((11, 1)), empty=False)
 matrix_cases("extended_kalman_filter", "x0", lambda x0: _ekf(x0=x0), np.zeros(2), shape=np.zeros(3), empty=False)
 bad("extended_kalman_filter", "sys linear matrix", lambda: _ekf(sys=A2), "sys")
+def _dkf(sys=None, y=Y11, u=None, Q=Q2, R=R1, P0=np.eye(2), x0=np.zeros(2)):
+    return ck.discrete_kalman_filter(sys2(dt=0.1) if sys is None else sys, y, u, Q=Q, R=R, P0=P0, x0=x0)
+
+ok("discrete_kalman_filter", "good", _dkf)
+bad("discrete_kalman_filter", "sys a matrix", lambda: _dkf(sys=A2), "sys")
+bad("discrete_kalman_filter", "sys continuous", lambda: _dkf(sys=sys2()), "sys", also="discrete")
+bad("discrete_kalman_filter", "sys nonlinear", lambda: _dkf(sys=pend()), "sys")
+# y sets the number of samples N, so its wrong shape is a wrong number of columns
+matrix_cases("discrete_kalman_filter", "y", lambda y: _dkf(y=y), Y11, shape=np.zeros((11, 2)))
+bad("discrete_kalman_filter", "y shorter than u", lambda: _dkf(y=np.zeros((10, 1)), u=np.zeros((11, 1))),
+    "y", also="too short")
+bad("discrete_kalman_filter", "y with no samples", lambda: _dkf(y=np.zeros((0, 1))), "y")
+matrix_cases("discrete_kalman_filter", "u", lambda u: _dkf(u=u), np.zeros((11, 1)), empty=False, optional=True)
+matrix_cases("discrete_kalman_filter", "Q", lambda Q: _dkf(Q=Q), Q2)
+matrix_cases("discrete_kalman_filter", "R", lambda R: _dkf(R=R), R1, empty=False)
+matrix_cases("discrete_kalman_filter", "P0", lambda P0: _dkf(P0=P0), np.eye(2))
+matrix_cases("discrete_kalman_filter", "x0", lambda x0: _dkf(x0=x0), np.zeros(2), shape=np.zeros(3), empty=False)
+bad("discrete_kalman_filter", "Q not symmetric", lambda: _dkf(Q=[[1.0, 1.0], [0.0, 1.0]]), "Q")
+bad("discrete_kalman_filter", "Q indefinite", lambda: _dkf(Q=np.diag([1.0, -1.0])), "Q")
+bad("discrete_kalman_filter", "R zero", lambda: _dkf(R=[[0.0]]), "R")
+bad("discrete_kalman_filter", "P0 indefinite", lambda: _dkf(P0=np.diag([1.0, -1.0])), "P0")
 matrix_cases("white_noise", "t", lambda t: ck.white_noise(t, 1.0, seed=0), T11, shape=np.ones((3, 3)), empty=False)
 scalar_cases("white_noise", "intensity", lambda q: ck.white_noise(T11, q, seed=0), 1.0)
 bad("white_noise", "intensity negative", lambda: ck.white_noise(T11, -1.0, seed=0), "intensity")
