@@ -56,7 +56,7 @@ from ._validation import as_scalar, as_series, as_square, as_time_grid, as_vecto
 from .linearization import _jacobian, _perturbed, _quotients
 from .observability import _obs_pair
 from .simulation import SimulationResult, _agrees_column_by_column, lti_step_matrices
-from .systems import NonlinearSystem, StateSpace
+from .systems import NonlinearSystem, StateSpace, _raw_field, _raw_output
 
 __all__ = [
     "kalman_gain",
@@ -767,10 +767,11 @@ def _ekf_model(sys, p: int, dfdx, dhdx, x0, u0):
             raise ValueError(f"{name} must be a function (x, u) -> Jacobian, or None for "
                              f"numerical differences: received {type(fun).__name__}.")
     n = sys.n
-    if dfdx is None and dhdx is None and _accepts_batches(sys.f, x0, u0) \
-            and _accepts_batches(sys.h, x0, u0):
-        return _batched_model(sys.f, sys.h, n)
-    f, h = _user(sys.f, "f"), _user(sys.h, "h")
+    f_raw, h_raw = _raw_field(sys), _raw_output(sys)   # wrapped once, by _user, with the time
+    if dfdx is None and dhdx is None and _accepts_batches(f_raw, x0, u0) \
+            and _accepts_batches(h_raw, x0, u0):
+        return _batched_model(f_raw, h_raw, n)
+    f, h = _user(f_raw, "f"), _user(h_raw, "h")
     jf = _user_jacobian(dfdx, "dfdx", (n, n), "∂f/∂x (4.92), n x n") if dfdx else \
         (lambda x, v, t: _jacobian(lambda z: f(z, v, t), x, refine=False))
     jh = _user_jacobian(dhdx, "dhdx", (p, n), "∂h/∂x (4.93), p x n") if dhdx else \
@@ -804,9 +805,9 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
                          "for a StateSpace use kalman_bucy.")
     t, u, y = _records(t, u, y, sys.m)
     x0 = _initial_estimate(x0, sys.n)
-    _user(sys.f, "f")(x0, u[0], t[0])
+    _user(_raw_field(sys), "f")(x0, u[0], t[0])
     sys.check(x0, u[0])
-    p_h = _user(sys.h, "h")(x0, u[0], t[0]).size
+    p_h = _user(_raw_output(sys), "h")(x0, u[0], t[0]).size
     if p_h != y.shape[1]:
         raise ValueError(f"y has the wrong number of columns: received {y.shape[1]}, expected "
                          f"{p_h} (the number of outputs of sys.h).")
