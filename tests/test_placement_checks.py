@@ -22,21 +22,24 @@ EPS = np.finfo(float).eps
 # ------------------------------------------------------------------------------------------
 # An independent statement of the documented contract
 
-def matched(M, poles):
-    """eig(M) matched to `poles` by an optimal assignment, and the pole scale."""
+def matched(M, poles, A=None):
+    """eig(M) matched to `poles` by an optimal assignment, and the pole scale: the largest
+    requested or achieved pole, or the spectral radius of the open loop A if larger, as in
+    place's docstring."""
     poles = np.asarray(poles, dtype=complex)
     eig = np.linalg.eigvals(M)
     rows, cols = linear_sum_assignment(np.abs(eig[:, None] - poles[None, :]))
     got = np.empty_like(poles)
     got[cols] = eig[rows]
-    return got, max(np.abs(poles).max(), np.abs(got).max())
+    radius = 0.0 if A is None else np.abs(np.linalg.eigvals(A)).max()
+    return got, max(np.abs(poles).max(), np.abs(got).max(), radius)
 
 
-def assert_poles_met(M, poles):
+def assert_poles_met(M, poles, A=None):
     """The docstrings' promise when no warning is issued: a pole requested k times has its k
     eigenvalues averaging to it within 1e-6 of the scale, each within 1e-6^(1/k) of it."""
     poles = np.asarray(poles, dtype=complex)
-    got, scale = matched(M, poles)
+    got, scale = matched(M, poles, A)
     for value in np.unique(poles):          # repeated poles in these tests are exact copies
         group = poles == value
         k = group.sum()
@@ -68,13 +71,13 @@ def checked(design, A, B, poles, *, observer=False):
     M = A - G @ B if observer else A + B @ G
     accuracy = [w for w in caught if issubclass(w.category, ck.AccuracyWarning)]
     if accuracy:
-        _, scale = matched(M, poles)
+        _, scale = matched(M, poles, A)
         # dual roles for the observer: (A^T, C^T, L^T) is the feedback problem
         pair = (A.T, B.T, G.T) if observer else (A, B, G)
         bound = rounding_bound(*pair, M, scale)
         assert bound > 1e-9, f"warned although rounding explains only {bound:.1e}: {accuracy[0].message}"
     else:
-        assert_poles_met(M, poles)
+        assert_poles_met(M, poles, A)
     return G, bool(accuracy)
 
 
