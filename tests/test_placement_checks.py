@@ -1,10 +1,8 @@
 """place and place_observer check their own result (issue 14): achieved poles, unit changes,
 rank-deficient B and C, poles repeated more often than there are inputs, SI-unit systems."""
 
-import contextlib
 import importlib
 import warnings
-from unittest import mock
 
 import control
 import numpy as np
@@ -233,20 +231,6 @@ def test_full_rank_inputs_are_minus_python_controls_place(n, m, seed):
 # ------------------------------------------------------------------------------------------
 # Random systems in random units
 
-@contextlib.contextmanager
-def verdict_taken_as_given():
-    """Skip the controllability / observability verdict (these pairs are controllable by
-    construction: cond(Wc) <= 1e6 before the change of units).
-
-    The verdict is not this module's subject, and on this branch it is still the naive rank of
-    Wc, which changes with units (issue 14, item 1); with the unit-proof verdict merged this
-    context manager can go and the tests stay as they are.
-    """
-    with mock.patch.object(placement, "require_controllable", lambda *args, **kwargs: None), \
-            mock.patch.object(observability, "require_observable", lambda *args, **kwargs: None):
-        yield
-
-
 @given(st.integers(2, 6), st.integers(0, 10_000), units)
 @settings(max_examples=40)
 def test_single_input_gain_transforms_with_the_units(n, seed, unit_change):
@@ -258,8 +242,7 @@ def test_single_input_gain_transforms_with_the_units(n, seed, unit_change):
     K, _ = checked(ck.place, A, B, poles)
     A_u, B_u, D, a = change_units(A, B, *unit_change)
     # a (A + B K) has poles a * poles, and in x_u = D x the same feedback reads K D^-1
-    with verdict_taken_as_given():
-        K_u, _ = checked(ck.place, A_u, B_u, a * poles)
+    K_u, _ = checked(ck.place, A_u, B_u, a * poles)
     # K is unique, and both are computed in balanced coordinates, which undo D up to powers
     # of 2; what is left is rounding amplified by the conditioning of the gain: at most
     # 4e-13 relative over 300 random draws with cond(Wc) <= 1e6, so 1e-9 leaves a factor 1000
@@ -277,9 +260,8 @@ def test_several_inputs_rank_deficient_or_repeated_in_any_units(n, m, seed, unit
     poles = pole_set(rng, n, 3)                          # repeats up to 3 > rank(B) = r
     A_u, B_u, _, a = change_units(A, B, *unit_change)
     C_u = B_u.T                                           # the dual: an observer with these outputs
-    with verdict_taken_as_given():
-        K, _ = checked(ck.place, A_u, B_u, a * poles)
-        L, _ = checked(ck.place_observer, A_u.T, C_u, a * poles, observer=True)
+    K, _ = checked(ck.place, A_u, B_u, a * poles)
+    L, _ = checked(ck.place_observer, A_u.T, C_u, a * poles, observer=True)
     assert K.shape == (m, n) and L.shape == (n, m)
 
 
@@ -293,21 +275,19 @@ def dc_motor():
     return A, B
 
 
-def test_dc_motor_in_si_units_through_the_method():
-    # Calls the method after the controllability check: on this branch the naive rank test of
-    # require_controllable still calls this motor uncontrollable (issue 14, item 1); once the
-    # unit-proof verdict is merged, ck.place(A, B, poles) returns the same K.
+def test_dc_motor_in_si_units():
+    # the naive rank of Wc called this motor uncontrollable (issue 14); place must design for it
     A, B = dc_motor()
     poles = np.array([-100, -200, -300], dtype=complex)
-    K, match = placement._gain(A, B, poles)
-    assert match.ratio <= 1.0
-    assert_poles_met(A + B @ K, poles)
+    K, warned = checked(ck.place, A, B, poles)
+    assert not warned
+    assert_poles_met(A + B @ K, poles, A)
     # independent oracle: the closed-loop characteristic polynomial (3.43) by coefficients,
     # each entry of A + B K is exact to ~eps * |R/L| = 3e-10, far below these coefficients
     np.testing.assert_allclose(np.poly(A + B @ K), np.poly(poles).real, rtol=1e-8)
     # the same motor with time in ms and current in mA: the same feedback law in new units
     D, a = np.diag([1.0, 1.0, 1e3]), 1e-3
-    K_u, _ = placement._gain(a * D @ A @ np.linalg.inv(D), a * D @ B, a * poles)
+    K_u, _ = checked(ck.place, a * D @ A @ np.linalg.inv(D), a * D @ B, a * poles)
     np.testing.assert_allclose(K_u @ D, K, rtol=1e-9)
 
 
