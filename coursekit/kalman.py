@@ -375,10 +375,9 @@ class KalmanResult:
         return np.sqrt(np.maximum(np.diagonal(self.P, axis1=1, axis2=2), 0.0))
 
     def __repr__(self) -> str:
-        n, p = self.L.shape[1:]
         return (f"KalmanResult: {self.t.size} samples from t={self.t[0]:g} to t={self.t[-1]:g}; "
-                f"x {self.x.shape}, P (N, {n}, {n}), L (N, {n}, {p})"
-                + ("" if self.M is None else f", M (N, {n}, {p})"))
+                f"x {self.x.shape}, P {self.P.shape}, L {self.L.shape}"
+                + ("" if self.M is None else f", M {self.M.shape}"))
 
 
 def _records(t, u, y, m: int):

@@ -300,4 +300,4 @@ def test_filter_reports_divergence_with_the_sample():
 def test_filter_result_repr_and_sigma():
     res = ck.discrete_kalman_filter(ck.StateSpace(A_d, B_d, C, dt=Ts), np.zeros(5), Q=Q_d, R=R_d,
                                     P0=np.eye(2), x0=[0, 0])
-    assert "M (N, 2, 1)" in repr(res) and res.sigma.shape == (5, 2)
+    assert "P (5, 2, 2), L (5, 2, 1), M (5, 2, 1)" in repr(res) and res.sigma.shape == (5, 2)
