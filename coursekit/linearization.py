@@ -109,6 +109,7 @@ _LADDER = 30
 _TABLEAU = 6
 _ABSOLUTE_TOP = 0.25
 _RELATIVE = 16.0
+_OTHER = 0.6            # the second absolute ladder's top step, in units of the first's
 
 
 def _probe(g: Callable, z: np.ndarray):
@@ -179,8 +180,16 @@ def _ridders_column(D: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, float
 
 
 def _column(g: Callable, z: np.ndarray, k: int, q: int) -> tuple[np.ndarray, float]:
-    """(dg/dz_k, error estimate) from the absolute ladder, or the relative one where it agrees."""
+    """(dg/dz_k, error estimate) from the absolute ladder, or the relative one where it agrees.
+
+    The tableau's own estimate can be fooled by noise or a kink (a lucky
+    agreement of two entries), so a second absolute ladder on other points
+    (its top step is not a power of two times the first's) is computed as
+    well, and the two results' disagreement is a lower bound of the error.
+    """
     J, err = _ridders_column(*_quotient_ladder(g, z, k, q, _ABSOLUTE_TOP))
+    J_other, err_other = _ridders_column(*_quotient_ladder(g, z, k, q, _ABSOLUTE_TOP * _OTHER))
+    err = max(err, err_other, float(np.abs(J - J_other).max()))
     if abs(z[k]) > _RELATIVE:
         h0 = 2.0 ** np.round(np.log2(abs(z[k]))) / 4
         J_rel, err_rel = _ridders_column(*_quotient_ladder(g, z, k, q, h0))
@@ -286,7 +295,8 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     h e_k)) / 2h over a ladder of 30 steps halving from h = 1/4 (and, for
     |x_k| > 16, a second ladder from |x_k| / 4, used where it agrees),
     extrapolated (Richardson, up to h^12) and chosen by its error estimate
-    (Ridders' method). The step does not grow with |x*|: for smooth f the
+    (Ridders' method), which is cross-checked against a second ladder on
+    other points (a noisy or kinked f makes the two disagree). The step does not grow with |x*|: for smooth f the
     result is accurate to about 1e-10 relative to each column's size,
     wherever x* lies (the pendulum at 1000 turns as at 0), and for
     polynomials and exponentials of large arguments as well. A column whose
