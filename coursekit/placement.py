@@ -14,8 +14,6 @@ import warnings
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.linalg import hessenberg, matrix_balance
-from scipy.optimize import linear_sum_assignment
 
 from ._validation import as_poles
 from .controllability import NotControllableError, _pair, _rank, ccf_transform, require_controllable
@@ -240,6 +238,7 @@ def _balancing(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     n = A.shape[0]
     M = np.zeros((n + B.shape[1], n + B.shape[1]))
     M[:n, :n], M[:n, n:] = A, B
+    from scipy.linalg import matrix_balance   # imported here: `import coursekit` stays light
     _, (scale, _) = matrix_balance(M, permute=False, separate=True)
     return scale[:n]
 
@@ -259,6 +258,7 @@ def _single_input(A: np.ndarray, b: np.ndarray, poles: np.ndarray) -> np.ndarray
     d = _balancing(A, b.reshape(n, 1))
     A_b, b_b = A / d[:, None] * d, b / d
     Q1, beta = _householder(b_b)                              # Q1^T b = beta e_1
+    from scipy.linalg import hessenberg
     H, Q2 = hessenberg(Q1.T @ A_b @ Q1, calc_q=True)           # Q2 e_1 = e_1
     sub = np.diag(H, -1)
     if beta == 0 or np.any(sub == 0):
@@ -333,6 +333,7 @@ class _PoleMatch:
             self.scale, self.ratio = float(np.abs(poles).max()), np.inf
             return
         eig = np.linalg.eigvals(M)
+        from scipy.optimize import linear_sum_assignment
         rows, cols = linear_sum_assignment(np.abs(eig[:, None] - poles[None, :]))
         self.achieved = np.empty_like(poles)
         self.achieved[cols] = eig[rows]
