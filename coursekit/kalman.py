@@ -753,8 +753,10 @@ def _batched_model(f, h, n: int):
 def _ekf_model(sys, p: int, dfdx, dhdx, x0, u0):
     """(x, u, t) -> (f(x, u), h(x, u), A, C), A and C the Jacobians (4.92)-(4.93).
 
-    dfdx and dhdx where given, else central differences (step ~ eps^(1/3),
-    those of `linearize` without its refinement). When both are numerical
+    dfdx and dhdx where given, else one central difference per state with
+    step ~ eps^(1/3) max(1, |x_k|) (about 1e-8 relative: cheaper than the
+    checked Ridders derivatives of `linearize`, which one step of a filter
+    does not need). When both are numerical
     and f and h accept a batch of states (`_accepts_batches`, checked once
     here, as it holds for every `coursekit.models` system), each is called
     once per evaluation (`_batched_model`); otherwise once per perturbed state.
@@ -786,7 +788,8 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
     (4.87)-(4.88) where A(t) = ∂f/∂x (4.92) and C(t) = ∂h/∂x (4.93) are
     evaluated at the estimate x̂(t). `dfdx(x, u)` -> (n, n) and
     `dhdx(x, u)` -> (p, n) may be supplied; by default they are computed by
-    central differences (step ~ eps^(1/3); the helper `linearize` uses, without its refinement).
+    one central difference per state (step ~ eps^(1/3) max(1, |x_k|), about
+    1e-8 relative; `linearize` uses the slower, checked Ridders derivatives).
 
     `u` (N, m) or None and `y` (N, p) are the recorded data on the grid `t`;
     Q, R are intensities, P0 > 0 the initial P, x0 the initial estimate.
