@@ -80,6 +80,23 @@ def call_user(func: Callable, args: tuple, name: str, *, where: str = "",
     return arr
 
 
+def call_user_fast(func: Callable, args: tuple, name: str, *, where: Callable[[], str]) -> np.ndarray:
+    """`call_user` for hot loops (a model called at every solver or filter step).
+
+    Finite real numbers are returned after one check. Anything else (an
+    exception, None, complex, NaN/inf, not numbers) repeats the call through
+    `call_user`, whose `UserFunctionError` explains it; `where()` builds the
+    context string only then.
+    """
+    try:
+        value = np.asarray(func(*args))
+        if value.dtype.kind in "fiu" and np.isfinite(value).all():
+            return value.astype(float, copy=False)
+    except Exception:  # explained below, by the repeated call
+        pass
+    return call_user(func, args, name, where=where())
+
+
 def warn_accuracy(message: str, *, stacklevel: int = 3) -> None:
     """Issue an `AccuracyWarning` pointing at the caller of the public function (internal)."""
     warnings.warn(message, AccuracyWarning, stacklevel=stacklevel)

@@ -51,7 +51,7 @@ from typing import Callable
 
 import numpy as np
 
-from .diagnostics import UserFunctionError, call_user, warn_accuracy
+from .diagnostics import UserFunctionError, call_user_fast, warn_accuracy
 from ._validation import as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
 from .linearization import _jacobian, _perturbed, _quotients
 from .observability import _obs_pair
@@ -702,23 +702,12 @@ def _at(t: float) -> str:
 
 def _user(fun, name: str, *, batch: bool = False):
     """(x, u, t) -> fun(x, u) as a finite float array, or a `UserFunctionError` naming
-    `name` and the time t (`diagnostics.call_user`).
-
-    Fast path: a finite float array is returned as is. Anything else (an
-    exception, NaN/inf, complex, not numbers) is handed to `call_user`, which
-    calls fun again and reports it; the EKF calls f and h four times per
-    RK4 step, so the common case costs one sum, not a full check.
-    """
+    `name` and the time t (`diagnostics.call_user_fast`: the EKF calls f and h four times
+    per RK4 step, so the common case costs one finiteness check)."""
     extra = " (on x̂ and its central-difference neighbours, as columns)" if batch else ""
 
     def call(x, u, t):
-        try:
-            out = fun(x, u)
-            if isinstance(out, np.ndarray) and out.dtype == float and _finite(out):
-                return out
-        except Exception:                   # reported with its context by call_user below
-            pass
-        return call_user(fun, (x, u), name, where=_at(t) + extra)
+        return call_user_fast(fun, (x, u), name, where=lambda: _at(t) + extra)
     return call
 
 

@@ -14,7 +14,7 @@ from typing import Callable
 import numpy as np
 
 from ._validation import as_matrix, as_scalar, as_square, check_function_output
-from .diagnostics import UserFunctionError, call_user
+from .diagnostics import UserFunctionError, call_user, call_user_fast
 
 __all__ = ["StateSpace", "NonlinearSystem"]
 
@@ -93,19 +93,8 @@ def _at(x: np.ndarray, u: np.ndarray) -> str:
 
 
 def _evaluate(func: Callable, x: np.ndarray, u: np.ndarray, name: str) -> np.ndarray:
-    """func(x, u) as a float array of the shape func returns.
-
-    Fast path: finite real numbers are returned at once. Anything else (an
-    exception, None, complex, NaN/inf, not numbers) repeats the call through
-    `call_user`, whose `UserFunctionError` names `name` and the point (x, u).
-    """
-    try:
-        value = np.asarray(func(x, u))
-        if value.dtype.kind in "fiu" and np.isfinite(value).all():
-            return value.astype(float, copy=False)
-    except Exception:  # explained below, by the repeated call
-        pass
-    return call_user(func, (x, u), name, where=_at(x, u))
+    """func(x, u) as a float array; a failure is explained naming `name` and the point (x, u)."""
+    return call_user_fast(func, (x, u), name, where=lambda: _at(x, u))
 
 
 def _raw_field(sys) -> Callable:
