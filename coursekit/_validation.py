@@ -25,6 +25,7 @@ __all__ = [
     "as_poles",
     "as_integer",
     "as_text",
+    "as_flag",
     "time_grid",
     "check_function_output",
 ]
@@ -207,6 +208,14 @@ def as_integer(value, name: str, *, minimum: int | None = None, why: str = "") -
         reason = f" ({why})" if why else ""
         raise ValueError(f"{name} must be at least {minimum}: received {k}{reason}.")
     return k
+
+
+def as_flag(value, name: str, *, hint: str = "") -> bool:
+    """Return `value` as a bool: only True or False (numpy's too); "yes", None or 1 are refused."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ValueError(f"{name} must be True or False: received {type(value).__name__} {value!r}"
+                         + (f"; {hint}" if hint else "") + ".")
+    return bool(value)
 
 
 def as_text(value, name: str, *, expected: str = "a string") -> str:

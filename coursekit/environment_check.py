@@ -18,6 +18,8 @@ import sys
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ._validation import as_flag
+
 __all__ = ["check_environment", "EnvironmentReport", "MINIMUM_VERSIONS", "find_widget_frontend"]
 
 #: lower bounds of pyproject.toml (dependencies and the dev extra); a test keeps them in sync
@@ -165,8 +167,7 @@ def check_environment(*, show: bool = True) -> EnvironmentReport:
     3.10, and when the JupyterLab front-end of ipywidgets is not installed.
     Returns an `EnvironmentReport`; ``show=False`` only builds it.
     """
-    if not isinstance(show, bool):
-        raise ValueError(f"show must be True or False: received {show!r}.")
+    show = as_flag(show, "show")
     names = [*MINIMUM_VERSIONS, *(n for n in _OPTIONAL if n not in MINIMUM_VERSIONS)]
     versions = {name: _installed_version(name) for name in names}
     python = ".".join(map(str, sys.version_info[:3]))

@@ -28,7 +28,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_vector
+from ._validation import as_flag, as_matrix, as_scalar, as_vector
 from .controllability import _pair, ccf_transform, charpoly
 from .diagnostics import warn_accuracy
 from .trajectory import _PLAN_RTOL, _input_time, _plan_grid, plot_plan, poly_trajectory
@@ -274,16 +274,9 @@ def car_like_flatness(L: float = 2.5, reverse: bool = False) -> FlatSystem:
     return _robot_flatness("car-like robot", reverse, steering, dict(L=L))
 
 
-def _as_flag(value, name: str) -> bool:
-    """`value` as a bool; anything but True/False (a string "yes", None, 1) is refused, naming `name`."""
-    if not isinstance(value, (bool, np.bool_)):
-        raise ValueError(f"{name} must be True or False: received {type(value).__name__} {value!r}.")
-    return bool(value)
-
-
 def _robot_flatness(name: str, reverse: bool, second_input: Callable, params: dict) -> FlatSystem:
     """The flat maps shared by both robots; `second_input(D, |F'|^2, v)` gives u2."""
-    reverse = _as_flag(reverse, "reverse")
+    reverse = as_flag(reverse, "reverse")
     sign = -1.0 if reverse else 1.0
 
     def psi_x(D):

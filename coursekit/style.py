@@ -9,6 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._validation import as_flag, as_integer, as_vector
+
 __all__ = ["lecture_mode", "is_lecture_mode", "new_figure", "LECTURE_STYLE"]
 
 #: matplotlib settings applied by ``lecture_mode(True)``.
@@ -37,9 +39,7 @@ def lecture_mode(on: bool = True) -> None:
     plotting helpers and explorers built after the call. ``lecture_mode(False)``
     restores the settings that were in force before it was switched on.
     """
-    if not isinstance(on, bool):
-        raise ValueError(f"on must be True or False: received {on!r}; "
-                         "call lecture_mode() to switch on, lecture_mode(False) to switch off.")
+    on = as_flag(on, "on", hint="call lecture_mode() to switch on, lecture_mode(False) to switch off")
     import matplotlib as mpl
     global _saved
     if on:
@@ -64,7 +64,6 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplot_kw):
     it as the last expression of a notebook cell.
     """
     from matplotlib.figure import Figure
-    from ._validation import as_integer, as_vector
     from .layout import fit_margins
     nrows = as_integer(nrows, "nrows", minimum=1, why="one row of axes at least")
     ncols = as_integer(ncols, "ncols", minimum=1, why="one column of axes at least")
