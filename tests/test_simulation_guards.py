@@ -192,9 +192,9 @@ def test_batch_wraps_an_exception_from_u():
 ])
 def test_solver_options_are_checked_up_front_on_every_path(options, message):
     # the exact LTI path ignores the options, but a typo must not pass silently there either
-    for sys in (ck.models.pendulum(), ck.models.mass_spring_damper()):
+    for system in (ck.models.pendulum(), ck.models.mass_spring_damper()):
         with pytest.raises(ValueError, match=message):
-            ck.simulate(sys, np.linspace(0, 1, 11), x0=[1, 0], **options)
+            ck.simulate(system, np.linspace(0, 1, 11), x0=[1, 0], **options)
     with pytest.raises(ValueError, match=message):
         ck.simulate_batch(ck.models.pendulum(), np.linspace(0, 1, 11), [[1, 0]], **options)
 
