@@ -167,7 +167,7 @@ def robot_planner_explorer() -> Explorer:
         ax, ax_u = fig.subplots(1, 2, width_ratios=[1.3, 1])
         path, = ax.plot([], [], "k--", label="planned path F_d")
         driven, = ax.plot([], [], color="C0", alpha=0.8, label="driven (model 1.10)")
-        goal = ax.quiver([0.0], [0.0], [1.0], [0.0], color="C3", scale=12, label="target pose")
+        goal = ax.quiver([0.0], [0.0], [1.0], [0.0], color="C3", scale=12, label="target pose", zorder=3)
         ax.plot([0], [0], "ko")
         ax.set_xlabel("x1 [m]")
         ax.set_ylabel("x2 [m]")
@@ -192,10 +192,12 @@ def robot_planner_explorer() -> Explorer:
         tu = r["t"][:r["u"].shape[0]]
         h["u1"].set_data(tu, r["u"][:, 0])
         h["u2"].set_data(tu, r["u"][:, 1])
-        for ax in (h["ax"], h["ax_u"]):
-            ax.relim()
-        # the target arrow is not part of relim: include start and target explicitly
-        h["ax"].update_datalim([[0.0, 0.0], [tx, ty]])
+        h["ax_u"].relim()
+        # the data limits of the path axes from its points, start and target: not relim(), which
+        # in newer matplotlib counts the arrow at a place that moves with the view, so the view
+        # would widen at every update
+        h["ax"].ignore_existing_data_limits = True
+        h["ax"].update_datalim(np.vstack([r["path"][:, :2], r["driven"][:, :2], [[0.0, 0.0], [tx, ty]]]))
         for ax in (h["ax"], h["ax_u"]):
             ax.autoscale_view()
         h["ax"].set_title(f"two-wheeled robot to ({tx:g} m, {ty:g} m, {np.rad2deg(th):g} deg) "
