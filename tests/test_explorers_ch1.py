@@ -66,7 +66,7 @@ def test_bad_input_raises_value_error(call, match):
 def test_euler_explorer_builds_and_refreshes():
     ex = euler_explorer()
     assert set(ex.controls) == {"Ts", "example"}
-    assert all(getattr(w, "continuous_update", False) is False for w in ex.controls.values()
+    assert all(getattr(w, "continuous_update", True) is True for w in ex.controls.values()
                if hasattr(w, "continuous_update"))
     ex.widget  # build the live widget (observers attached)
     ex.controls["Ts"].value = 0.8

@@ -66,4 +66,4 @@ def test_explorers_build_label_and_refresh(factory):
     widget.value = widget.max
     e.refresh()
     assert e.params[name] == widget.max and e.result is not before
-    assert widget.continuous_update is False
+    assert widget.continuous_update is True   # the figure follows the slider while it is dragged

@@ -1,4 +1,4 @@
-"""The machinery shared by every explorer: sliders that redraw one figure.
+"""The machinery shared by every explorer: sliders that redraw one figure as they move.
 
 An explorer is three plain functions and a set of controls:
 
@@ -7,52 +7,70 @@ An explorer is three plain functions and a set of controls:
 * ``draw(fig)`` -- builds the axes and empty artists once, returns handles;
 * ``update(handles, result)`` -- moves the artists' data to a new result.
 
-`Explorer` wires them to ipywidgets sliders (``continuous_update=False``, so
-the figure is recomputed when the slider is released) and shows the figure as
-an image widget. It also carries a static PNG of the figure in its display
-data, so a renderer without a live widget front-end (GitHub, nbviewer, an
-exported HTML) shows the figure for the default parameters instead of a bare
-widget repr.
+`Explorer` wires them to ipywidgets controls that report every move while a
+slider is dragged (``continuous_update=True``; the widget front end keeps at
+most one change in flight and sends only the latest value, so a redraw never
+falls behind the hand) and shows the figure in a `FigureView`. Each frame is
+drawn by a `FrameRenderer`: the axes, ticks and labels are drawn once and
+reused while only curves and titles move, so a frame costs a few tens of
+milliseconds instead of a full draw.
 
-Exported HTML: ``jupyter nbconvert --to html --execute`` stores the widget
-state, and the page's embedded widget manager (loaded from unpkg.com) draws
-the widget with the figure from that state; with
-``--ExecutePreprocessor.store_widget_state=False`` the page shows the static
-PNG as a plain image, which also works offline.
+The figure is rendered at the pixel size it is shown with: the view reports
+the screen's device pixel ratio and the room available (the output width, and
+the visible height less the explorer's controls), and the figure is scaled
+down to fit. In `coursekit.lecture_mode` (switched on before the explorer is
+built) the figure also grows to fill the room, and the text in the figure and
+in the controls is larger.
+
+The explorer also carries a static PNG of the figure (at its natural size) in
+its display data, so a renderer without a live kernel (GitHub, nbviewer, an
+exported HTML page, the course website) shows the figure for the default
+parameters instead of an empty widget area.
 """
 
 from __future__ import annotations
 
 import base64
-import io
 from typing import Any, Callable
 
+from ._frames import FrameRenderer, encode_png
+
 __all__ = ["Explorer", "slider", "int_slider", "dropdown", "figure_png", "rescale"]
+
+#: an explorer is never shrunk below this fraction of its natural size to fit the screen
+MIN_SCALE = 0.45
+
+#: in lecture mode an explorer grows up to this factor to fill the room it has
+LECTURE_MAX_SCALE = 2.0
+
+
+def _control_layout():
+    import ipywidgets as widgets
+    return widgets.Layout(width="auto")
 
 
 def slider(value: float, min: float, max: float, step: float, description: str, *,
            readout_format: str = ".3g"):
-    """A FloatSlider that fires on release (``continuous_update=False``)."""
+    """A FloatSlider that reports every move while it is dragged."""
     import ipywidgets as widgets
     return widgets.FloatSlider(value=value, min=min, max=max, step=step, description=description,
-                               continuous_update=False, readout_format=readout_format,
-                               style={"description_width": "initial"},
-                               layout=widgets.Layout(width="320px"))
+                               continuous_update=True, readout_format=readout_format,
+                               style={"description_width": "initial"}, layout=_control_layout())
 
 
 def int_slider(value: int, min: int, max: int, description: str, *, step: int = 1):
-    """An IntSlider that fires on release (``continuous_update=False``)."""
+    """An IntSlider that reports every move while it is dragged."""
     import ipywidgets as widgets
     return widgets.IntSlider(value=value, min=min, max=max, step=step, description=description,
-                             continuous_update=False, style={"description_width": "initial"},
-                             layout=widgets.Layout(width="320px"))
+                             continuous_update=True, style={"description_width": "initial"},
+                             layout=_control_layout())
 
 
 def dropdown(options, value, description: str):
     """A Dropdown for a discrete choice (e.g. which controller)."""
     import ipywidgets as widgets
     return widgets.Dropdown(options=options, value=value, description=description,
-                            style={"description_width": "initial"})
+                            style={"description_width": "initial"}, layout=_control_layout())
 
 
 def rescale(*axes) -> None:
@@ -63,23 +81,23 @@ def rescale(*axes) -> None:
 
 
 def figure_png(fig) -> bytes:
-    """Render a matplotlib figure to PNG bytes, at the figure's dpi.
-
-    One Agg draw (which also sets the margins, see
-    `coursekit.layout.fit_margins`) and a PNG encode, without the extra
-    passes `savefig` may make. The Agg canvas is attached to the figure once
-    and reused, so its renderer is kept between slider moves. zlib level 1
-    encodes in about half the time of the default level, for a PNG about
-    15 % larger.
-    """
+    """Render a matplotlib figure to PNG bytes, at the figure's dpi (one Agg draw)."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.image import imsave
     canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
     canvas.draw()
-    buf = io.BytesIO()
-    imsave(buf, canvas.buffer_rgba(), format="png", dpi=fig.dpi,
-           pil_kwargs={"compress_level": 1})
-    return buf.getvalue()
+    return encode_png(canvas.buffer_rgba(), fig.dpi)
+
+
+def _fit_scale(natural_px, screen: dict, largest: float = 1.0) -> float:
+    """The factor (at most `largest`) by which a figure of `natural_px` (width, height) fits the
+    reported room."""
+    width, height = (float(screen.get(key) or 0) for key in ("width", "height"))
+    scale = largest
+    if width > 0:
+        scale = min(scale, width / natural_px[0])
+    if height > 0:
+        scale = min(scale, height / natural_px[1])
+    return max(scale, MIN_SCALE)
 
 
 class Explorer:
@@ -98,62 +116,125 @@ class Explorer:
     update : callable
         ``update(handles, result) -> None``; sets the artists' data.
     figsize : tuple, optional
-        Figure size in inches; default from matplotlib's settings (so
-        `lecture_mode` enlarges it).
+        Natural figure size in inches (shown at the figure's dpi, 100 pixels
+        per inch by default); default from matplotlib's settings. The figure
+        is shown smaller when the screen has less room; in lecture mode it
+        also grows (up to `LECTURE_MAX_SCALE` times) to fill the room.
     """
 
     def __init__(self, *, title: str, controls: dict[str, Any], compute: Callable[..., Any],
                  draw: Callable[[Any], Any], update: Callable[[Any, Any], None], figsize=None):
+        from matplotlib import rcParams
         from matplotlib.figure import Figure
+
         from ..layout import fit_margins
+        from ..style import is_lecture_mode
         self.title = title
         self.controls = dict(controls)
         self._compute = compute
         self._update = update
-        self.fig = fit_margins(Figure(figsize=figsize))
+        self.lecture = is_lecture_mode()
+        self.fig = fit_margins(Figure(figsize=figsize or rcParams["figure.figsize"]))
+        self.natural_dpi = float(self.fig.dpi)
         self.handles = draw(self.fig)
-        self.result = None
-        self._png = b""
+        self.screen: dict = {}
+        self.result = self._compute(**self.params)
+        # update, then watch the update repeated: the artists it touches are the ones that move
+        self._update(self.handles, self.result)
+        self.frames = FrameRenderer(self.fig)
+        self._update(self.handles, self.result)
+        self._png = self.frames.frame()
         self._widget = None
-        self.refresh()
+        self._view = None
 
     @property
     def params(self) -> dict[str, Any]:
         """The current value of every control, by name."""
         return {name: w.value for name, w in self.controls.items()}
 
+    @property
+    def png(self) -> bytes:
+        """The figure as last drawn (PNG bytes, at the size it is shown with)."""
+        return self._png
+
     def refresh(self) -> None:
         """Recompute for the current control values and redraw the figure."""
         self.result = self._compute(**self.params)
         self._update(self.handles, self.result)
-        self._png = figure_png(self.fig)
-        if self._widget is not None:
-            self._image.value = self._png
+        self._show()
+
+    def static_png(self) -> bytes:
+        """The figure for the current settings at its natural size (what a static page shows)."""
+        if self.fig.dpi == self.natural_dpi:
+            return self._png
+        shown = self.fig.dpi
+        self.fig.set_dpi(self.natural_dpi)
+        png = self.frames.frame()
+        self.fig.set_dpi(shown)
+        self.frames.frame()
+        return png
+
+    def _show(self) -> None:
+        self._png = self.frames.frame()
+        if self._view is not None:
+            ratio = float(self.screen.get("ratio") or 1.0)
+            height, width = self.frames.canvas.buffer_rgba().shape[:2]
+            with self._view.hold_sync():
+                self._view.png = self._png
+                self._view.css_width = width / ratio
+                self._view.css_height = height / ratio
+                self._view.alt = self._alt_text()
 
     def _on_change(self, change) -> None:
         self.refresh()
 
+    def _on_screen(self, change) -> None:
+        """Render at the size the figure is shown with: scaled to fit, at the screen's pixel ratio."""
+        self.screen = dict(change["new"] or {})
+        ratio = float(self.screen.get("ratio") or 1.0)
+        natural = self.fig.get_size_inches() * self.natural_dpi
+        largest = LECTURE_MAX_SCALE if self.lecture else 1.0
+        dpi = self.natural_dpi * _fit_scale(natural, self.screen, largest) * ratio
+        if abs(dpi - self.fig.dpi) > 1e-6:
+            self.fig.set_dpi(dpi)
+        self._show()
+
+    def _settings(self) -> str:
+        return ", ".join(f"{k}={v:g}" if isinstance(v, (int, float)) else f"{k}={v!r}"
+                         for k, v in self.params.items())
+
+    def _alt_text(self) -> str:
+        return f"{self.title} ({self._settings()})"
+
     @property
     def widget(self):
-        """The live widget: a title, the controls and the figure image."""
+        """The live widget: a title, the controls and the figure."""
         if self._widget is None:
             import ipywidgets as widgets
-            self._image = widgets.Image(value=self._png, format="png",
-                                        layout=widgets.Layout(max_width="100%"))
+
+            from ._view import FigureView
+            self._view = FigureView(png=self._png, alt=self._alt_text(),
+                                    css_width=float(self.frames.canvas.buffer_rgba().shape[1]),
+                                    css_height=float(self.frames.canvas.buffer_rgba().shape[0]))
+            self._view.observe(self._on_screen, names="screen")
             for w in self.controls.values():
                 w.observe(self._on_change, names="value")
             header = widgets.HTML(f"<b>{self.title}</b>")
-            boxes = widgets.GridBox(list(self.controls.values()),
-                                    layout=widgets.Layout(grid_template_columns="repeat(2, 340px)"))
-            self._widget = widgets.VBox([header, boxes, self._image])
+            header.add_class("ck-title")
+            column = "270px" if self.lecture else "300px"
+            boxes = widgets.GridBox(list(self.controls.values()), layout=widgets.Layout(
+                grid_template_columns=f"repeat(auto-fill, minmax({column}, 1fr))", width="100%"))
+            boxes.add_class("ck-controls")
+            self._widget = widgets.VBox([header, boxes, self._view])
+            self._widget.add_class("ck-explorer")
+            if self.lecture:
+                self._widget.add_class("ck-lecture")
         return self._widget
 
     def _repr_mimebundle_(self, include=None, exclude=None):
         bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude)
-        bundle["image/png"] = base64.b64encode(self._png).decode("ascii")
-        settings = ", ".join(f"{k}={v:g}" if isinstance(v, (int, float)) else f"{k}={v!r}"
-                             for k, v in self.params.items())
-        bundle["text/plain"] = f"{self.title} (static figure for {settings})"
+        bundle["image/png"] = base64.b64encode(self.static_png()).decode("ascii")
+        bundle["text/plain"] = f"{self.title} (static figure for {self._settings()})"
         return bundle
 
     def __repr__(self) -> str:

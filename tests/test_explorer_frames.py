@@ -1,0 +1,170 @@
+"""Explorer frames: a dragged slider gives the same figure as a fresh draw, mostly by blitting,
+rendered at the size and pixel ratio the browser reports."""
+
+import io
+
+import numpy as np
+import pytest
+from matplotlib.figure import Figure
+
+import coursekit as ck
+from coursekit.explorers import ch1, ch2, ch3, ch4
+from coursekit.explorers._base import MIN_SCALE
+from coursekit.explorers._frames import FrameRenderer, snap_limits
+
+FACTORIES = [ch1.euler_explorer, ch1.msd_explorer, ch2.planner_explorer, ch2.robot_planner_explorer,
+             ch3.pole_placement_explorer, ch3.upright_pendulum_explorer, ch3.integral_action_explorer,
+             ch4.observer_noise_explorer, ch4.kalman_tuning_explorer]
+
+
+@pytest.fixture(autouse=True)
+def _lecture_mode_off():
+    yield
+    ck.lecture_mode(False)
+
+
+def _pixels(png: bytes) -> np.ndarray:
+    from matplotlib.image import imread
+    return imread(io.BytesIO(png), format="png")
+
+
+def _size(png: bytes) -> tuple[int, int]:
+    return int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")
+
+
+def _sliders(explorer):
+    return {name: w for name, w in explorer.controls.items() if hasattr(w, "step") and hasattr(w, "max")}
+
+
+def _drag_values(widget, moves: int = 12) -> list:
+    """Values a hand passes through when dragging `widget` from its value towards its maximum and
+    on to its minimum, on the slider's own steps."""
+    up = np.linspace(widget.value, widget.max, moves // 2)
+    down = np.linspace(widget.max, widget.min, moves - moves // 2)
+    values = [widget.min + round((v - widget.min) / widget.step) * widget.step for v in np.r_[up, down]]
+    return [type(widget.value)(v) for v in values]
+
+
+@pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
+def test_dragging_the_first_slider_gives_the_figure_of_a_fresh_draw(factory):
+    dragged = factory()
+    name, widget = next(iter(_sliders(dragged).items()))
+    for value in _drag_values(widget):
+        widget.value = value
+        dragged.refresh()
+    fresh = factory()
+    fresh.controls[name].value = widget.value
+    fresh.refresh()
+    assert dragged.params == fresh.params
+    np.testing.assert_array_equal(_pixels(dragged.png), _pixels(fresh.png))
+    # most frames of the drag reuse the background: a fresh draw per frame is what is avoided
+    assert dragged.frames.blits >= 1
+
+
+@pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
+def test_every_slider_moves_the_figure(factory):
+    e = factory()
+    for name, widget in _sliders(e).items():
+        before = e.png
+        widget.value = widget.max if widget.value != widget.max else widget.min
+        e.refresh()
+        assert e.png != before, f"moving {name} did not change the figure"
+
+
+def test_a_small_move_blits_and_a_move_past_a_tick_draws_again():
+    fig = Figure(figsize=(4, 3))
+    ax = fig.subplots()
+    line, = ax.plot([0, 1], [0, 1])
+    title = ax.set_title("a = 1")
+    frames = FrameRenderer(fig)
+    line.set_data([0, 1], [0, 0.9])
+    title.set_text("a = 0.9")
+    frames.frame()                      # what changed since the renderer was made moves
+    assert frames.full_draws == 1 and set(frames._moving) == {line, title}
+    line.set_data([0, 1], [0, 0.95])    # the view stays [0, 1] plus margins: reuse the background
+    frames.frame()
+    assert (frames.full_draws, frames.blits) == (1, 1)
+    line.set_data([0, 1], [0, 3.3])     # past a tick: the axis changes, draw everything again
+    ax.relim()
+    ax.autoscale_view()
+    frames.frame()
+    assert (frames.full_draws, frames.blits) == (2, 1)
+    ax.set_ylabel("y [m]")              # a new axis label is part of the background too
+    frames.frame()
+    assert (frames.full_draws, frames.blits) == (3, 1)
+
+
+def test_snap_limits_puts_an_autoscaled_view_on_ticks_plus_margins():
+    ax = Figure().subplots()
+    ax.plot([0, 6], [0.03, 0.97])
+    snap_limits(ax)
+    lo, hi = ax.get_ylim()
+    assert (lo, hi) == pytest.approx((0 - 0.05, 1 + 0.05))
+    assert ax.get_xlim() == pytest.approx((-0.3, 6.3))
+    assert ax.get_autoscaley_on()          # still autoscaled: the next rescale may change it
+
+
+def test_snap_limits_widens_limits_set_by_hand_to_ticks_and_keeps_an_inverted_axis():
+    ax = Figure().subplots()
+    ax.set_xlim(-11.3, 4.0)
+    ax.set_ylim(7.3, -7.3)
+    snap_limits(ax)
+    assert ax.get_xlim() == pytest.approx((-12.5, 5.0)) or ax.get_xlim()[0] <= -11.3
+    lo, hi = ax.get_ylim()
+    assert lo > hi and lo >= 7.3 and hi <= -7.3
+
+
+def test_snap_limits_on_a_log_axis_stays_finite():
+    ax = Figure().subplots()
+    ax.semilogy([0, 1, 2], [1e-3, 2e-2, 0.7])
+    snap_limits(ax)
+    lo, hi = ax.get_ylim()
+    assert lo <= 1e-3 and hi >= 1.0 and np.isfinite([lo, hi]).all()
+
+
+def _shown(explorer, **screen):
+    view = explorer.widget.children[-1]
+    view.screen = screen                 # what the browser reports
+    return view
+
+
+def test_the_figure_is_rendered_at_the_pixel_size_it_is_shown_with():
+    e = ch1.euler_explorer()
+    natural = _size(e.png)
+    view = _shown(e, width=2000, height=2000, ratio=2.0)
+    assert _size(e.png) == (2 * natural[0], 2 * natural[1])      # crisp on a high-density screen
+    assert (view.css_width, view.css_height) == (natural[0], natural[1])
+    assert view.png == e.png
+    view = _shown(e, width=natural[0] // 2, height=2000, ratio=1.0)   # a narrow output area
+    width, height = _size(e.png)
+    assert width <= natural[0] // 2 + 1 and (view.css_width, view.css_height) == (width, height)
+    _shown(e, width=50, height=50, ratio=1.0)                       # never smaller than MIN_SCALE
+    assert _size(e.png)[0] >= MIN_SCALE * natural[0] - 1
+
+
+def test_the_static_figure_keeps_its_natural_size_after_the_browser_reports():
+    import base64
+    e = ch1.msd_explorer()
+    natural = _size(e.png)
+    _shown(e, width=500, height=300, ratio=2.0)
+    static = base64.b64decode(e._repr_mimebundle_()["image/png"])
+    assert _size(static) == natural and _size(e.png) != natural
+
+
+def test_lecture_mode_grows_the_figure_to_the_room_and_marks_the_widget():
+    ck.lecture_mode()
+    e = ch1.euler_explorer()
+    natural = _size(e.png)
+    _shown(e, width=3 * natural[0], height=3 * natural[1], ratio=1.0)
+    assert _size(e.png)[0] > 1.5 * natural[0]
+    assert "ck-lecture" in e.widget._dom_classes and "ck-explorer" in e.widget._dom_classes
+    ck.lecture_mode(False)
+    plain = ch1.euler_explorer()
+    _shown(plain, width=3 * natural[0], height=3 * natural[1], ratio=1.0)
+    assert _size(plain.png)[0] <= natural[0] + 1         # outside lecture mode: natural size at most
+    assert "ck-lecture" not in plain.widget._dom_classes
+
+
+def test_sliders_follow_the_hand():
+    e = ch3.pole_placement_explorer()
+    assert all(w.continuous_update for w in _sliders(e).values())
