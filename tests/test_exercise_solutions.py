@@ -97,11 +97,12 @@ def _run_keeping_last(code: str, namespace: dict, where: str) -> tuple[object, s
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
 def test_every_exercise_has_one_folded_solution_cell_right_after_it(path):
     cells = _cells(path)
-    exercises = [c for c in cells if _is_exercise_cell(c)]
-    headings = [c for c in cells if c.kind == "markdown" and c.source.startswith("### Exercise")]
-    assert exercises and len(exercises) == len(headings), (len(exercises), len(headings))
     code_solutions = [c.index for c in cells if c.kind == "code" and (_is_solution(c) or "assert ex.check_" in c.source)]
     assert not code_solutions, f"{path.name}: cells {code_solutions} are solutions in code cells (Run All runs them)"
+    exercises = [c for c in cells if _is_exercise_cell(c)]
+    headings = [c for c in cells if c.kind == "markdown" and c.source.startswith("### Exercise")]
+    assert exercises and len(exercises) == len(headings), (
+        f"{path.name}: {len(headings)} exercise headings but {len(exercises)} cells calling ex.check_*")
     solutions = [c for c in cells if _is_solution(c)]
     assert [c.index for c in solutions] == [c.index + 1 for c in exercises], (
         f"{path.name}: every exercise cell must be followed by exactly one solution cell, and nothing else "

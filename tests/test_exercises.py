@@ -464,7 +464,7 @@ def test_exercise_data_typeset_matrices_in_jupyter():
     markdown = ex.SEPARATION._repr_markdown_()
     assert r"`A` $= \begin{bmatrix} 0 & 1 \\ 3 & -2 \end{bmatrix}$" in markdown
     assert r"`C` $= \begin{bmatrix} 1 & 0 \end{bmatrix}$" in markdown
-    assert "`x_eq` $= [3.14159,\\ 0]$" in ex.LINEARIZE._repr_markdown_()
+    assert "`x_eq` $= [{3.14159},\\ {0}]$" in ex.LINEARIZE._repr_markdown_()
 
 
 def test_exercise_data_reject_what_is_not_a_mapping_of_names():

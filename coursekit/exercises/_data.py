@@ -92,6 +92,7 @@ def _latex_entry(value: Any) -> str:
     if arr.ndim == 0:
         return f"$= {_number(arr)}$"
     if arr.ndim == 1:
-        return "$= [" + r",\ ".join(_number(v) for v in arr) + "]$"
+        # braces keep a minus sign unary: [-1, -2] and not [-1, - 2]
+        return "$= [" + r",\ ".join("{" + _number(v) + "}" for v in arr) + "]$"
     rows = r" \\ ".join(" & ".join(_number(v) for v in row) for row in arr)
     return r"$= \begin{bmatrix} " + rows + r" \end{bmatrix}$"
