@@ -40,6 +40,7 @@ import numpy as np
 
 import coursekit as ck
 import coursekit.exercises as ex
+from coursekit.exercises._feedback import CheckResult
 from coursekit import models
 from coursekit.explorers import ch1 as xp1, ch2 as xp2, ch3 as xp3, ch4 as xp4
 
@@ -82,7 +83,7 @@ def ok(target: str, label: str, call: Callable) -> None:
 
 
 def feedback(target: str, label: str, call: Callable, says: str = "") -> None:
-    """An exercise check on a bad answer: prints "Not yet" feedback matching `says`, returns False."""
+    """An exercise check on a bad answer: prints "Not yet" feedback matching `says`; its result is false."""
     CASES.append(Case(target, label, call, "feedback", says))
 
 
@@ -825,7 +826,7 @@ def _run_case(case: Case) -> dict:
         return dict(status="pass", detail="")
     if case.kind == "bad":
         return dict(status="fail", detail=f"no error; returned {type(value).__name__}")
-    if value is False and printed.startswith("Not yet") and re.search(case.pattern, printed):
+    if isinstance(value, CheckResult) and not value and printed.startswith("Not yet") and re.search(case.pattern, printed):
         return dict(status="pass", detail=printed)
     return dict(status="fail", detail=f"returned {value!r}, printed {printed!r}")
 

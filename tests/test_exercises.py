@@ -11,12 +11,19 @@ import pytest
 import sympy as sp
 
 import coursekit.exercises as ex
+from coursekit.exercises._feedback import CheckResult
 from coursekit.placement import place
 
 MSD = ex.MSD
 CP = ex.COMPARTMENT
 PEN = ex.PENDULUM
 LIN = ex.LINEARIZE
+
+
+def _verdict(result) -> bool:
+    """A check's verdict: its result must be a CheckResult; True when correct."""
+    assert isinstance(result, CheckResult), f"a check returned {type(result).__name__}, not a CheckResult"
+    return bool(result)
 
 
 def _msd():
@@ -134,7 +141,7 @@ FORMS = {"list": _as_list, "array": np.asarray, "sympy": _as_sympy, "flat": _as_
 @pytest.mark.parametrize("name", RIGHT)
 def test_right_answer_in_every_form_is_correct(name, form, capsys):
     args = tuple(FORMS[form](a) for a in RIGHT[name]())
-    assert getattr(ex, name)(*args) is True
+    assert _verdict(getattr(ex, name)(*args)) is True
     out = capsys.readouterr().out
     assert out.startswith("Correct:"), out
 
@@ -142,7 +149,7 @@ def test_right_answer_in_every_form_is_correct(name, form, capsys):
 @pytest.mark.parametrize("name", ["check_ccf_transform", "check_msd_state_space", "check_trajectory_coefficients"])
 def test_answers_rounded_to_three_digits_are_accepted(name):
     args = tuple(np.round(np.asarray(a, dtype=float), 3) for a in RIGHT[name]())
-    assert getattr(ex, name)(*args) is True
+    assert _verdict(getattr(ex, name)(*args)) is True
 
 
 def test_other_right_answers(capsys):
@@ -210,7 +217,7 @@ WRONG = [
     ("check_car_flatness", (v_car ** 2, delta_car), "v is off"),
     ("check_trajectory_coefficients", (_alpha()[::-1],), "descending"),
     ("check_trajectory_coefficients", (_alpha()[:3],), "wrong shape"),
-    ("check_stability", ([True, True, False, True],), "matrix 2"),
+    ("check_stability", ([True, True, False, True],), "matrix A2"),
     ("check_stability", ([True, False, True, True],), "real part 0"),
     ("check_stability", ([True, False],), "4 entries"),
     ("check_gain_ccf", (-K_ccf,), "MATLAB sign"),
@@ -255,7 +262,7 @@ def _numbers_in(text: str) -> set[str]:
 
 @pytest.mark.parametrize("name, args, words", WRONG, ids=[f"{w[0]}-{w[2]}" for w in WRONG])
 def test_wrong_answer_is_named_and_solution_not_printed(name, args, words, capsys):
-    assert getattr(ex, name)(*args) is False
+    assert _verdict(getattr(ex, name)(*args)) is False
     out = capsys.readouterr().out
     assert out.startswith("Not yet"), out
     assert words in out, out
@@ -271,7 +278,7 @@ GARBAGE = ["abc", None, {"a": 1}, [[1, 2], [3]], float("nan"), sp.Matrix([[sp.Sy
 def test_garbage_never_raises(name, garbage, capsys):
     func = getattr(ex, name)
     nargs = func.__code__.co_argcount
-    assert func(*([garbage] * nargs)) is False
+    assert _verdict(func(*([garbage] * nargs))) is False
     out = capsys.readouterr().out
     assert out.startswith("Not yet") and len(out.splitlines()) >= 2, out
 
@@ -377,7 +384,7 @@ def test_bad_answer_gets_feedback_naming_the_problem(name, form, capsys):
     for i in range(len(right)):
         args = list(right)
         args[i] = make(right[i])
-        assert getattr(ex, name)(*args) is False, (i, args[i])
+        assert _verdict(getattr(ex, name)(*args)) is False, (i, args[i])
         out = capsys.readouterr().out
         assert out.startswith("Not yet") and re.search(says, out), out
 
@@ -398,6 +405,71 @@ def test_bad_answer_gets_feedback_naming_the_problem(name, form, capsys):
     (lambda: ex.check_car_flatness(_car()[0] + 1e-3j, _car()[1]), "complex"),
 ])
 def test_bad_answers_of_the_other_checks_get_feedback(call, says, capsys):
-    assert call() is False
+    assert _verdict(call()) is False
     out = capsys.readouterr().out
     assert out.startswith("Not yet") and says in out, out
+
+
+# ---------------------------------------------------------------------------
+# what a check returns and how the exercise data look
+
+
+def test_check_result_is_truthy_exactly_when_correct_and_reads_well_in_a_plain_repl(capsys):
+    right, wrong = ex.check_stability([True, False, False, True]), ex.check_stability(None)
+    assert bool(right) is True and bool(wrong) is False
+    assert repr(right) == "CheckResult(exercise='stability', correct=True)"
+    assert repr(wrong) == "CheckResult(exercise='stability', correct=False)"
+    capsys.readouterr()
+
+
+def test_check_result_shows_nothing_in_ipython():
+    """IPython formats it to an empty bundle, so a kernel sends no execute_result (no Out[n])."""
+    from IPython.core.formatters import DisplayFormatter
+    result = ex.check_stability([True, False, False, True])
+    assert DisplayFormatter().format(result) == ({}, {})
+    # a plain object on the same path does produce an Out line: the test can fail
+    assert DisplayFormatter().format(True)[0] == {"text/plain": "True"}
+
+
+def test_exercise_data_index_like_a_dict_and_stay_read_only():
+    assert ex.MSD["m"] == 2.0 and dict(ex.MSD) == {"m": 2.0, "d": 0.4, "k": 8.0}
+    assert np.array(ex.EULER["A"]).shape == (2, 2) and np.array(ex.EULER["B"]).shape == (2, 1)
+    assert list(ex.STABILITY) == ["A1", "A2", "A3", "A4"]
+    from coursekit import models
+    assert models.compartment(**ex.COMPARTMENT).n == 2
+    with pytest.raises(TypeError):
+        ex.MSD["m"] = 3.0
+
+
+def test_exercise_data_print_one_line_per_entry_with_matrices_as_aligned_rows():
+    assert str(ex.MSD) == "m = 2\nd = 0.4\nk = 8"
+    assert str(ex.ODE) == "a = [3, 5, 2]\nb = 4"
+    assert str(ex.CTRB) == ("A = [[1,  2,  0],\n"
+                            "     [0, -1,  1],\n"
+                            "     [1,  0, -2]]\n"
+                            "B = [[0],\n"
+                            "     [1],\n"
+                            "     [1]]")
+    assert repr(ex.OBSV).splitlines()[-1] == "C = [[1, 0, 1]]"   # a row stays a row
+    # what is printed reads back as the data
+    for name in ("CTRB", "SEPARATION", "STABILITY"):
+        data = getattr(ex, name)
+        namespace = {}
+        exec(str(data), namespace)
+        for key in data:
+            assert np.allclose(namespace[key], data[key]), (name, key)
+
+
+def test_exercise_data_typeset_matrices_in_jupyter():
+    markdown = ex.SEPARATION._repr_markdown_()
+    assert r"`A` $= \begin{bmatrix} 0 & 1 \\ 3 & -2 \end{bmatrix}$" in markdown
+    assert r"`C` $= \begin{bmatrix} 1 & 0 \end{bmatrix}$" in markdown
+    assert "`x_eq` $= [{3.14159},\\ {0}]$" in ex.LINEARIZE._repr_markdown_()
+
+
+def test_exercise_data_reject_what_is_not_a_mapping_of_names():
+    from coursekit.exercises._data import ExerciseData
+    with pytest.raises(TypeError, match="items must be a mapping"):
+        ExerciseData([("m", 1.0)])
+    with pytest.raises(TypeError, match="every name must be a string"):
+        ExerciseData({1: 1.0})

@@ -3,14 +3,15 @@
 One module per chapter (`ch1` ... `ch4`); every name is also available here::
 
     import coursekit.exercises as ex
-    ex.MSD                              # the exercise's numbers
+    ex.MSD                              # the exercise's numbers (shown as matrices)
     ex.check_msd_state_space(A, B, C)   # prints "Correct: ..." or what is off
 
 A check accepts the answer as a list, a nested list, a NumPy array or a sympy
 Matrix, compares it with a tolerance suited to hand computation, prints
 specific feedback (which entry, shape or sign is off, with the equation of
-the notes to recheck), returns True when correct, and never raises on a wrong
-answer or prints the solution.
+the notes to recheck), returns a result that is true exactly when the answer
+is correct (so ``assert ex.check_...(...)`` works; Jupyter shows no ``Out[n]``
+line for it), and never raises on a wrong answer or prints the solution.
 """
 
 from . import ch1, ch2, ch3, ch4

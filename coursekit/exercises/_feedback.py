@@ -12,7 +12,9 @@ so the feedback reads the same everywhere:
   (transposed, whole sign flipped, a known wrong variant such as the MATLAB
   sign of K) and finally names the entries that are off;
 * `Report` collects the messages and prints them once, starting with
-  "Correct" or "Not yet".
+  "Correct" or "Not yet", and returns a `CheckResult`: true exactly when the
+  answer is correct, so ``assert ex.check_...(...)`` works, and silent in
+  Jupyter (no ``Out[n]:`` line under the feedback it just printed).
 
 Nothing here raises on a wrong answer and nothing prints the expected values.
 """
@@ -27,6 +29,7 @@ import numpy as np
 from .._validation import _is_complex
 
 __all__ = [
+    "CheckResult",
     "Report",
     "close",
     "read_matrix",
@@ -48,6 +51,32 @@ def close(answer: np.ndarray, expected: np.ndarray, rtol: float = RTOL) -> np.nd
     return np.abs(answer - expected) <= rtol * np.maximum(1.0, np.abs(expected))
 
 
+class CheckResult:
+    """What a ``check_*`` returns: true exactly when the answer is correct.
+
+    The feedback has already been printed when a check returns, so in Jupyter
+    the result shows nothing: a check called on the last line of a cell leaves
+    no ``Out[n]:`` line. A plain Python prompt shows the short `repr`.
+    """
+
+    __slots__ = ("exercise", "correct")
+
+    def __init__(self, exercise: str, correct: bool):
+        self.exercise = exercise
+        self.correct = bool(correct)
+
+    def __bool__(self) -> bool:
+        return self.correct
+
+    def __repr__(self) -> str:
+        return f"CheckResult(exercise={self.exercise!r}, correct={self.correct})"
+
+    def _ipython_display_(self) -> None:
+        # IPython calls this instead of formatting the object; showing nothing sends no
+        # execute_result (the printed feedback above is the whole answer)
+        return None
+
+
 @dataclass
 class Report:
     """The feedback of one check: a list of problems, printed in one go."""
@@ -62,15 +91,15 @@ class Report:
     def ok(self) -> bool:
         return not self.problems
 
-    def show(self, praise: str) -> bool:
-        """Print "Correct: praise" or the problems; return True when correct."""
+    def show(self, praise: str) -> CheckResult:
+        """Print "Correct: praise" or the problems; the result is true when correct."""
         if self.ok:
             print(f"Correct: {praise}")
         else:
             print(f"Not yet ({self.name}):")
             for message in self.problems:
                 print(f"  - {message}")
-        return self.ok
+        return CheckResult(self.name, self.ok)
 
 
 def _is_sympy(value) -> bool:

@@ -6,8 +6,8 @@
 4. `ODE`: realization of a third-order ODE in the form (1.52)-(1.53).
 5. `EULER`: Euler discretization (1.43) of a linear system.
 
-Every check prints "Correct: ..." or what is off, returns True/False, and
-never prints the expected answer.
+Every check prints "Correct: ..." or what is off, returns a `CheckResult`
+(true when correct), and never prints the expected answer.
 """
 
 from __future__ import annotations
@@ -17,7 +17,8 @@ import numpy as np
 from .. import models
 from ..realization import euler_discretize, ode_to_ss
 from ..systems import StateSpace
-from ._feedback import Report, call_student_function, close, matrix_feedback
+from ._data import ExerciseData
+from ._feedback import CheckResult, Report, call_student_function, close, matrix_feedback
 
 __all__ = [
     "MSD", "check_msd_state_space",
@@ -28,22 +29,22 @@ __all__ = [
 ]
 
 #: m y'' + d y' + k y = u, m [kg], d [N s/m], k [N/m]; state x = [y, y'], output y.
-MSD = {"m": 2.0, "d": 0.4, "k": 8.0}
+MSD = ExerciseData({"m": 2.0, "d": 0.4, "k": 8.0})
 
 #: compartment model (1.4)-(1.5): volumes [l], rates [l/min], c0 [mg/l]; x = [c1, c2], y = c2.
-COMPARTMENT = {"V1": 2.0, "V2": 4.0, "q": 0.6, "q0": 0.2, "c0": 5.0}
+COMPARTMENT = ExerciseData({"V1": 2.0, "V2": 4.0, "q": 0.6, "q0": 0.2, "c0": 5.0})
 
 #: pendulum (1.8) with damping and torque: m [kg], l [m], g [m/s^2], d_theta [N m s]; x = [theta, theta'].
-PENDULUM = {"m": 0.5, "l": 0.8, "g": 9.81, "d_theta": 0.3}
+PENDULUM = ExerciseData({"m": 0.5, "l": 0.8, "g": 9.81, "d_theta": 0.3})
 
 #: y''' + a2 y'' + a1 y' + a0 y = b u with a = [a0, a1, a2] (ascending, as in (1.47)).
-ODE = {"a": (3.0, 5.0, 2.0), "b": 4.0}
+ODE = ExerciseData({"a": (3.0, 5.0, 2.0), "b": 4.0})
 
 #: x' = A x + B u discretized by Euler (1.43) with sampling period Ts [s].
-EULER = {"A": ((0.0, 1.0), (-2.0, -3.0)), "B": ((0.0,), (1.0,)), "Ts": 0.1}
+EULER = ExerciseData({"A": ((0.0, 1.0), (-2.0, -3.0)), "B": ((0.0,), (1.0,)), "Ts": 0.1})
 
 
-def check_msd_state_space(A, B, C) -> bool:
+def check_msd_state_space(A, B, C) -> CheckResult:
     """Check A, B, C of the mass-spring-damper `MSD` with x = [y, y'] and y the position."""
     report = Report("mass-spring-damper")
     m, d, k = MSD["m"], MSD["d"], MSD["k"]
@@ -63,7 +64,7 @@ def check_msd_state_space(A, B, C) -> bool:
     return report.show("x' = A x + B u, y = C x is the mass-spring-damper (1.57).")
 
 
-def check_compartment_state_space(A, B, C) -> bool:
+def check_compartment_state_space(A, B, C) -> CheckResult:
     """Check A, B, C of the compartment model `COMPARTMENT` with x = [c1, c2], y = c2."""
     report = Report("compartment model")
     p = COMPARTMENT
@@ -98,7 +99,7 @@ def _student_f(f, x, u, report: Report):
     return out
 
 
-def check_pendulum_f(f) -> bool:
+def check_pendulum_f(f) -> CheckResult:
     """Check a Python function ``f(x, u)`` returning [theta', theta''] for the pendulum (1.8).
 
     ``x = [theta, theta']`` (theta in rad, 0 hanging down) and ``u = [tau]`` [N m];
@@ -146,7 +147,7 @@ def check_pendulum_f(f) -> bool:
     return report.show("")
 
 
-def check_ode_realization(A, B, C) -> bool:
+def check_ode_realization(A, B, C) -> CheckResult:
     """Check the realization of the `ODE` with state x = [y, y', y''] (1.48)-(1.53)."""
     report = Report("ODE realization")
     a = np.asarray(ODE["a"], dtype=float)
@@ -170,7 +171,7 @@ def check_ode_realization(A, B, C) -> bool:
     return report.show("this is the realization (1.52)-(1.53) of the ODE.")
 
 
-def check_euler_discretization(Ad, Bd) -> bool:
+def check_euler_discretization(Ad, Bd) -> CheckResult:
     """Check x(t+1) = Ad x(t) + Bd u(t), the Euler discretization (1.43) of `EULER`."""
     from scipy.linalg import expm
     report = Report("Euler discretization")

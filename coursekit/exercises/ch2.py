@@ -14,7 +14,8 @@ import numpy as np
 
 from ..controllability import ccf_transform, ctrb
 from ..flatness import car_like_flatness
-from ._feedback import Report, close, matrix_feedback, rank_decision_feedback, read_numbers
+from ._data import ExerciseData
+from ._feedback import CheckResult, Report, close, matrix_feedback, rank_decision_feedback, read_numbers
 
 __all__ = [
     "CTRB", "check_ctrb_matrix",
@@ -25,20 +26,22 @@ __all__ = [
 ]
 
 #: x' = A x + B u with three states and one input.
-CTRB = {"A": ((1.0, 2.0, 0.0), (0.0, -1.0, 1.0), (1.0, 0.0, -2.0)), "B": ((0.0,), (1.0,), (1.0,))}
+CTRB = ExerciseData({"A": ((1.0, 2.0, 0.0), (0.0, -1.0, 1.0), (1.0, 0.0, -2.0)),
+                     "B": ((0.0,), (1.0,), (1.0,))})
 
 #: is this (A, B) controllable?
-KALMAN = {"A": ((0.0, 1.0, 1.0), (1.0, 0.0, 1.0), (1.0, 1.0, 0.0)), "B": ((1.0,), (-1.0,), (0.0,))}
+KALMAN = ExerciseData({"A": ((0.0, 1.0, 1.0), (1.0, 0.0, 1.0), (1.0, 1.0, 0.0)),
+                       "B": ((1.0,), (-1.0,), (0.0,))})
 
 #: a second-order system that is not in CCF.
-CCF = {"A": ((1.0, 2.0), (3.0, 0.0)), "B": ((0.0,), (1.0,))}
+CCF = ExerciseData({"A": ((1.0, 2.0), (3.0, 0.0)), "B": ((0.0,), (1.0,))})
 
 #: car-like robot (1.11): wheelbase L [m] and, at one instant, F' = (x1', x2') [m/s],
 #: F'' = (x1'', x2'') [m/s^2] of the flat output F = (x1, x2).
-CAR = {"L": 2.5, "dF": (3.0, 4.0), "ddF": (-1.0, 2.0)}
+CAR = ExerciseData({"L": 2.5, "dF": (3.0, 4.0), "ddF": (-1.0, 2.0)})
 
 #: y'' = u (a CCF with a0 = a1 = 0): move from x(0) = (y, y') = x0 to x(T) = xT in T seconds.
-TRAJECTORY = {"T": 2.0, "x0": (0.0, 1.0), "xT": (2.0, 0.0)}
+TRAJECTORY = ExerciseData({"T": 2.0, "x0": (0.0, 1.0), "xT": (2.0, 0.0)})
 
 
 def _blocks(A: np.ndarray, B: np.ndarray) -> list[np.ndarray]:
@@ -48,7 +51,7 @@ def _blocks(A: np.ndarray, B: np.ndarray) -> list[np.ndarray]:
     return blocks
 
 
-def check_ctrb_matrix(Wc) -> bool:
+def check_ctrb_matrix(Wc) -> CheckResult:
     """Check the controllability matrix Wc = [B, AB, A^2 B] of `CTRB` (2.13)."""
     report = Report("controllability matrix")
     A, B = np.array(CTRB["A"]), np.array(CTRB["B"])
@@ -62,7 +65,7 @@ def check_ctrb_matrix(Wc) -> bool:
     return report.show("Wc = [B, AB, A^2 B] (2.13).")
 
 
-def check_kalman_decision(rank, controllable) -> bool:
+def check_kalman_decision(rank, controllable) -> CheckResult:
     """Check the rank of Wc for `KALMAN` and the decision of Kalman's criterion."""
     report = Report("Kalman criterion")
     A, B = np.array(KALMAN["A"]), np.array(KALMAN["B"])
@@ -75,7 +78,7 @@ def check_kalman_decision(rank, controllable) -> bool:
     return report.show("rank Wc decides controllability (Kalman's criterion).")
 
 
-def check_ccf_transform(T) -> bool:
+def check_ccf_transform(T) -> CheckResult:
     """Check the transform z = T x that puts `CCF` in controllability canonical form (2.65)."""
     report = Report("CCF transform")
     A, B = np.array(CCF["A"]), np.array(CCF["B"])
@@ -100,7 +103,7 @@ def _car_solution(sign: float) -> tuple[float, float]:
     return float(v), float(delta)
 
 
-def check_car_flatness(v, delta) -> bool:
+def check_car_flatness(v, delta) -> CheckResult:
     """Check the speed v [m/s] and steering angle delta [rad] of the car-like robot at `CAR`.
 
     Either sign of v is accepted (driving forwards or backwards along the same
@@ -141,7 +144,7 @@ def check_car_flatness(v, delta) -> bool:
                        "with F = (x1, x2) and therefore controllable.")
 
 
-def check_trajectory_coefficients(alpha) -> bool:
+def check_trajectory_coefficients(alpha) -> CheckResult:
     """Check [alpha0, alpha1, alpha2, alpha3] of y_d(t) for `TRAJECTORY` (2.33)-(2.38)."""
     report = Report("trajectory coefficients")
     T = TRAJECTORY["T"]

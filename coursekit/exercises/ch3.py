@@ -16,7 +16,8 @@ from .. import models
 from ..linearization import linearize
 from ..placement import place
 from ..stability import is_stable
-from ._feedback import Report, matrix_feedback, read_decision
+from ._data import ExerciseData
+from ._feedback import CheckResult, Report, matrix_feedback, read_decision
 
 __all__ = [
     "STABILITY", "check_stability",
@@ -25,29 +26,30 @@ __all__ = [
     "LINEARIZE", "check_pendulum_linearization",
 ]
 
-#: four continuous-time systems x' = A x; which are (asymptotically) stable?
-STABILITY = (
-    ((-1.0, 2.0), (-2.0, -1.0)),
-    ((1.0, 2.0), (3.0, -4.0)),
-    ((0.0, 1.0), (-4.0, 0.0)),
-    ((-2.0, 5.0, 0.0), (0.0, -1.0, 7.0), (0.0, 0.0, -0.5)),
-)
+#: four continuous-time systems x' = A x (A1 ... A4); which are (asymptotically) stable?
+STABILITY = ExerciseData({
+    "A1": ((-1.0, 2.0), (-2.0, -1.0)),
+    "A2": ((1.0, 2.0), (3.0, -4.0)),
+    "A3": ((0.0, 1.0), (-4.0, 0.0)),
+    "A4": ((-2.0, 5.0, 0.0), (0.0, -1.0, 7.0), (0.0, 0.0, -0.5)),
+})
 
 #: x' = A x + B u in CCF (last-row form (2.16)) and the wanted closed-loop poles.
-PLACE_CCF = {"A": ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (4.0, -1.0, 2.0)),
-             "B": ((0.0,), (0.0,), (1.0,)), "poles": (-1.0, -2.0, -4.0)}
+PLACE_CCF = ExerciseData({"A": ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (4.0, -1.0, 2.0)),
+                          "B": ((0.0,), (0.0,), (1.0,)), "poles": (-1.0, -2.0, -4.0)})
 
 #: a 2x2 system that is not in CCF and the wanted closed-loop poles.
-PLACE_GENERAL = {"A": ((1.0, 2.0), (3.0, 0.0)), "B": ((0.0,), (1.0,)), "poles": (-2.0, -3.0)}
+PLACE_GENERAL = ExerciseData({"A": ((1.0, 2.0), (3.0, 0.0)), "B": ((0.0,), (1.0,)), "poles": (-2.0, -3.0)})
 
 #: damped pendulum (1.8), linearized at the upright equilibrium x* = [pi, 0], u* = 0.
-LINEARIZE = {"m": 0.5, "l": 0.8, "g": 9.81, "d_theta": 0.3, "x_eq": (np.pi, 0.0)}
+LINEARIZE = ExerciseData({"m": 0.5, "l": 0.8, "g": 9.81, "d_theta": 0.3, "x_eq": (np.pi, 0.0)})
 
 
-def check_stability(answers) -> bool:
-    """Check a list of four True/False: is x' = A x stable, for each A of `STABILITY`?"""
+def check_stability(answers) -> CheckResult:
+    """Check a list of four True/False: is x' = A x stable, for A1 ... A4 of `STABILITY`?"""
     report = Report("stability")
-    truth = [is_stable(A) for A in STABILITY]   # every eigenvalue strictly in the left half-plane
+    matrices = list(STABILITY.values())
+    truth = [is_stable(A) for A in matrices]   # every eigenvalue strictly in the left half-plane
     if isinstance(answers, (str, bytes)) or not hasattr(answers, "__len__"):
         report.add(f"answers must be a list of {len(truth)} True/False, one per matrix: "
                    f"received {answers!r}.")
@@ -59,7 +61,7 @@ def check_stability(answers) -> bool:
         decision = read_decision(answer, f"answer {i}", report)
         if decision is None or decision == right:
             continue
-        A = np.array(STABILITY[i - 1])
+        A = np.array(matrices[i - 1])
         if np.allclose(np.linalg.eigvals(A).real.max(), 0, atol=1e-9):
             hint = ("an eigenvalue with real part 0 (on the imaginary axis) is not strictly "
                     "negative: the state oscillates or stays, it does not go to 0.")
@@ -68,7 +70,7 @@ def check_stability(answers) -> bool:
                     "negative: compute them.")
         else:
             hint = "compute the eigenvalues: for a triangular matrix they are the diagonal entries."
-        report.add(f"matrix {i} is decided wrongly: stable means every eigenvalue of A has a "
+        report.add(f"the matrix A{i} is decided wrongly: stable means every eigenvalue of A has a "
                    f"strictly negative real part (section 3.2.2); {hint}")
     return report.show("each decision follows from the real parts of the eigenvalues (3.2.2).")
 
@@ -92,13 +94,13 @@ def _gain_feedback(K, A: np.ndarray, B: np.ndarray, poles, report: Report, *, hi
     return ok
 
 
-def _check_gain(K, data: dict, title: str, hint: str, praise: str) -> bool:
+def _check_gain(K, data: ExerciseData, title: str, hint: str, praise: str) -> CheckResult:
     report = Report(title)
     _gain_feedback(K, np.array(data["A"]), np.array(data["B"]), data["poles"], report, hint=hint)
     return report.show(praise)
 
 
-def check_gain_ccf(K) -> bool:
+def check_gain_ccf(K) -> CheckResult:
     """Check the gain K (u = K x) placing the poles of `PLACE_CCF`, from (3.42)-(3.44)."""
     return _check_gain(K, PLACE_CCF, "pole placement in CCF",
                        hint="Read a0, a1, a2 from the last row of A (it is -[a0 a1 a2]), expand "
@@ -106,7 +108,7 @@ def check_gain_ccf(K) -> bool:
                        praise="eig(A + B K) are the wanted poles (3.44).")
 
 
-def check_gain_general(K) -> bool:
+def check_gain_general(K) -> CheckResult:
     """Check the gain K (u = K x) placing the poles of `PLACE_GENERAL` via the CCF (3.46)-(3.47)."""
     return _check_gain(K, PLACE_GENERAL, "pole placement, general case",
                        hint="Find T (2.65), the CCF's a~ from T A T^-1, K~ from (3.46), then "
@@ -114,7 +116,7 @@ def check_gain_general(K) -> bool:
                        praise="eig(A + B K) are the wanted poles, K = K~ T (3.47).")
 
 
-def check_pendulum_linearization(A, B) -> bool:
+def check_pendulum_linearization(A, B) -> CheckResult:
     """Check (A, B) of the pendulum `LINEARIZE` linearized at theta = pi, theta' = 0 (3.67)."""
     report = Report("linearized pendulum")
     m, l, g, d = (LINEARIZE[k] for k in ("m", "l", "g", "d_theta"))

@@ -13,7 +13,9 @@ import numpy as np
 from ..observability import obsv, place_observer
 from ..observers import separation_eigenvalues
 from ..systems import StateSpace
-from ._feedback import Report, matrix_feedback, poles_feedback, rank_decision_feedback, read_poles
+from ._data import ExerciseData
+from ._feedback import (CheckResult, Report, matrix_feedback, poles_feedback, rank_decision_feedback,
+                        read_poles)
 
 __all__ = [
     "OBSV", "check_obsv_matrix",
@@ -23,20 +25,21 @@ __all__ = [
 ]
 
 #: x' = A x, y = C x with three states and one measurement.
-OBSV = {"A": ((0.0, 1.0, 0.0), (2.0, 0.0, 1.0), (0.0, -1.0, -3.0)), "C": ((1.0, 0.0, 1.0),)}
+OBSV = ExerciseData({"A": ((0.0, 1.0, 0.0), (2.0, 0.0, 1.0), (0.0, -1.0, -3.0)),
+                     "C": ((1.0, 0.0, 1.0),)})
 
 #: the vehicle (4.1) with a speedometer (4.3): x = [position, velocity], m [kg], d [N s/m].
-VEHICLE = {"A": ((0.0, 1.0), (0.0, -0.05)), "C": ((0.0, 1.0),)}
+VEHICLE = ExerciseData({"A": ((0.0, 1.0), (0.0, -0.05)), "C": ((0.0, 1.0),)})
 
 #: a 2x2 system with one measurement and the wanted poles of the estimation error.
-OBSERVER = {"A": ((0.0, 1.0), (-2.0, -3.0)), "C": ((1.0, 0.0),), "poles": (-5.0, -6.0)}
+OBSERVER = ExerciseData({"A": ((0.0, 1.0), (-2.0, -3.0)), "C": ((1.0, 0.0),), "poles": (-5.0, -6.0)})
 
 #: plant, state-feedback gain (u = K x^) and observer gain of an output-feedback loop.
-SEPARATION = {"A": ((0.0, 1.0), (3.0, -2.0)), "B": ((0.0,), (1.0,)), "C": ((1.0, 0.0),),
-              "K": ((-9.0, -3.0),), "L": ((7.0,), (9.0,))}
+SEPARATION = ExerciseData({"A": ((0.0, 1.0), (3.0, -2.0)), "B": ((0.0,), (1.0,)), "C": ((1.0, 0.0),),
+                           "K": ((-9.0, -3.0),), "L": ((7.0,), (9.0,))})
 
 
-def check_obsv_matrix(Wo) -> bool:
+def check_obsv_matrix(Wo) -> CheckResult:
     """Check the observability matrix Wo = [C; CA; CA^2] of `OBSV` (4.15)."""
     report = Report("observability matrix")
     A, C = np.array(OBSV["A"]), np.array(OBSV["C"])
@@ -50,7 +53,7 @@ def check_obsv_matrix(Wo) -> bool:
     return report.show("Wo = [C; CA; CA^2] (4.15).")
 
 
-def check_vehicle_observability(rank, observable) -> bool:
+def check_vehicle_observability(rank, observable) -> CheckResult:
     """Check the rank of Wo for `VEHICLE` and whether it is observable (section 4.2.3)."""
     report = Report("vehicle observability")
     A, C = np.array(VEHICLE["A"]), np.array(VEHICLE["C"])
@@ -63,7 +66,7 @@ def check_vehicle_observability(rank, observable) -> bool:
     return report.show("rank Wo decides observability; a speedometer never reveals the position.")
 
 
-def check_observer_gain(L) -> bool:
+def check_observer_gain(L) -> CheckResult:
     """Check the observer gain L with eig(A - L C) = the poles of `OBSERVER` (4.27)."""
     report = Report("observer gain")
     A, C = np.array(OBSERVER["A"]), np.array(OBSERVER["C"])
@@ -85,7 +88,7 @@ def check_observer_gain(L) -> bool:
     return report.show("eig(A - L C) are the wanted error poles (4.27).")
 
 
-def check_separation_poles(poles) -> bool:
+def check_separation_poles(poles) -> CheckResult:
     """Check the 4 eigenvalues of the output-feedback loop of `SEPARATION` (plant + observer)."""
     report = Report("output feedback")
     A, B, C = (np.array(SEPARATION[k]) for k in ("A", "B", "C"))
