@@ -168,3 +168,15 @@ def test_lecture_mode_grows_the_figure_to_the_room_and_marks_the_widget():
 def test_sliders_follow_the_hand():
     e = ch3.pole_placement_explorer()
     assert all(w.continuous_update for w in _sliders(e).values())
+
+
+def test_encode_png_drops_alpha_only_when_every_pixel_is_opaque():
+    from coursekit.explorers._frames import encode_png
+    rgba = np.full((6, 5, 4), 255, dtype=np.uint8)
+    rgba[2, 3] = [10, 20, 30, 255]
+    opaque = _pixels(encode_png(rgba, 100))
+    assert opaque.shape == (6, 5, 3)
+    np.testing.assert_array_equal(np.round(opaque * 255), rgba[..., :3])
+    rgba[0, 0, 3] = 0
+    see_through = _pixels(encode_png(rgba, 100))
+    assert see_through.shape == (6, 5, 4) and see_through[0, 0, 3] == 0

@@ -34,10 +34,15 @@ __all__ = ["FrameRenderer", "snap_limits", "encode_png"]
 
 
 def encode_png(rgba, dpi: float) -> bytes:
-    """PNG bytes of an RGBA buffer (zlib level 1: half the time of the default, ~15 % larger)."""
-    from matplotlib.image import imsave
+    """PNG bytes of an RGBA buffer, fast: zlib level 1 (half the time of the default level, for a
+    file about 15 % larger), and without the alpha channel when every pixel is opaque (a
+    quarter less to compress)."""
+    from PIL import Image   # matplotlib's own image library
+    pixels = np.asarray(rgba)
+    if pixels[..., 3].min() == 255:
+        pixels = np.ascontiguousarray(pixels[..., :3])
     buf = io.BytesIO()
-    imsave(buf, np.asarray(rgba), format="png", dpi=dpi, pil_kwargs={"compress_level": 1})
+    Image.fromarray(pixels).save(buf, format="png", compress_level=1, dpi=(dpi, dpi))
     return buf.getvalue()
 
 
@@ -82,6 +87,25 @@ def snap_limits(ax) -> None:
         if np.all(np.isfinite(snapped)) and snapped[0] < snapped[1]:   # not on a log axis with data <= 0
             set_(snapped[::-1] if flipped else snapped, auto=None)
     ax.apply_aspect()
+
+
+def _paint_area(artist, renderer):
+    """Where `artist` may paint, in display pixels: its clip box when it is clipped (a curve
+    stays inside its axes whatever its data), else its extent now; None when unknown (an Axes or
+    Axis, which are never left out)."""
+    from matplotlib.axes import Axes
+    from matplotlib.axis import Axis
+    if isinstance(artist, (Axes, Axis)):
+        return None
+    box = artist.get_clip_box() if artist.get_clip_on() else None
+    return box if box is not None else artist.get_window_extent(renderer)
+
+
+def _overlaps(a, b, pad: float = 2.0) -> bool:
+    """True unless both boxes are known and more than `pad` pixels apart."""
+    if a is None or b is None:
+        return True
+    return not (a.x1 + pad < b.x0 or b.x1 + pad < a.x0 or a.y1 + pad < b.y0 or b.y1 + pad < a.y0)
 
 
 def _is_stale(artist) -> bool:
@@ -164,6 +188,7 @@ class FrameRenderer:
         from matplotlib.axes import Axes
         from matplotlib.axis import Axis
         from matplotlib.image import AxesImage
+        renderer = self.canvas.get_renderer()
         out = []
         for parent in (*self.fig.axes, self.fig):
             children = [a for a in parent.get_children() if a is not parent.patch]
@@ -171,7 +196,11 @@ class FrameRenderer:
             first = next((i for i, a in enumerate(order) if a in moving), None)
             if first is None:
                 continue
-            tail = order[first:]
+            areas = [_paint_area(a, renderer) for a in order[first:] if a in moving]
+            # a still artist drawn later than a moving one is redrawn over it only where they can
+            # meet: a legend beside the axes stays in the background, one inside is redrawn
+            tail = [a for a in order[first:]
+                    if a in moving or any(_overlaps(_paint_area(a, renderer), area) for area in areas)]
             if any(isinstance(a, (Axes, Axis, AxesImage)) for a in tail):
                 return None
             out.extend(tail)
