@@ -108,7 +108,7 @@ def plot_response(result, which: str = "xu", *, state_names=None, output_names=N
     letters = [c for c in which if series[c].shape[1] > 0]
     if not letters:
         raise ValueError(f"which={which!r} selects no signal: the system has no input; use which='x'.")
-    fig, axes = new_figure(len(letters), 1, figsize=figsize, sharex=True)
+    fig, axes = new_figure(len(letters), 1, figsize=figsize or _stacked_size(len(letters)), sharex=True)
     axes = np.atleast_1d(axes)
     discrete = getattr(result.system, "is_discrete", False)
     for ax, letter in zip(axes, letters):
@@ -131,7 +131,18 @@ def _draw_signals(ax, t, data, names, units, *, discrete: bool) -> None:
     for j in range(data.shape[1]):
         label = names[j] if same else f"{names[j]} [{units[j]}]"
         ax.plot(t, data[:, j], label=label, **style)
-    ax.legend(loc="best")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
+
+
+def _stacked_size(rows: int) -> tuple[float, float]:
+    """Default size of a figure of `rows` stacked axes: matplotlib's default size (lecture
+    mode's, when on), made taller where needed to give each axes the height of ten axis-label
+    font sizes, so that a rotated y label fits along its axes at any font size."""
+    from matplotlib import rcParams
+    from matplotlib.font_manager import FontProperties
+    width, height = rcParams["figure.figsize"]
+    label = FontProperties(size=rcParams["axes.labelsize"]).get_size_in_points()
+    return (width, max(height, rows * 10 * label / 72 + 1.2))
 
 
 def _trajectory_list(trajectories, states) -> list[tuple[np.ndarray, bool]]:
@@ -288,11 +299,11 @@ def plot_euler_comparison(exact, approximations, *, state: int = 0, state_name: 
     ax.set_ylim(ref.min() - 0.5 * span, ref.max() + 0.5 * span)
     ax.set_xlim(exact.t[0], exact.t[-1])
     ax.set_ylabel(f"{name} [{unit}]")
-    ax.legend(loc="best")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     ax.grid(True, alpha=0.4)
     ax_err.set_ylabel(f"|error| [{unit}]")
     ax_err.set_xlabel(_time_label(time_unit))
     ax_err.grid(True, which="both", alpha=0.3)
-    ax_err.legend(loc="best")
+    ax_err.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     fig.suptitle(title if title is not None else "Exact solution against Euler discretization (1.43)")
     return fig

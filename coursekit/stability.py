@@ -123,18 +123,24 @@ def plot_poles(poles, *, dt=None, ax=None, title: str | None = None):
         angle = np.linspace(0, 2 * np.pi, 200)
         ax.fill(np.cos(angle), np.sin(angle), color="tab:green", alpha=0.12, label="stable region (|z| < 1)")
         ax.plot(np.cos(angle), np.sin(angle), color="tab:green", lw=1)
-        ax.set_aspect("equal", adjustable="box")
+        ax.set_aspect("equal", adjustable="datalim")   # the axes fills its cell, as the layout sets it
     markers = "xo^sd*"
     for i, (label, values) in enumerate(sets.items()):
         ax.plot(values.real, values.imag, markers[i % len(markers)], ms=10, mew=2,
                 fillstyle="none", label=label)
     ax.axhline(0, color="0.5", lw=0.8)
     ax.axvline(0, color="0.5", lw=0.8)
-    ax.set_xlim(-reach, reach)
-    ax.set_ylim(-reach, reach)
+    if dt is None:
+        ax.set_xlim(-reach, reach)
+        ax.set_ylim(-reach, reach)
+    else:
+        # equal scales (the unit circle stays round): fixed limits would be overridden
+        ax.margins(0)
+        ax.update_datalim([(-reach, -reach), (reach, reach)])
+        ax.autoscale_view()
     ax.set_xlabel("real part [1/s]" if dt is None else "real part")
     ax.set_ylabel("imaginary part [rad/s]" if dt is None else "imaginary part")
     ax.set_title(title or ("Poles (continuous time)" if dt is None else "Poles (discrete time)"))
-    ax.legend(loc="best")
+    ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     ax.grid(True, alpha=0.3)
     return fig, ax

@@ -76,7 +76,7 @@ def pole_placement_explorer() -> Explorer:
     """Sliders for a pole pair (wn, zeta) and a real pole: K, pole plot, x(t) and u(t)."""
     def draw(fig):
         ax_p, ax_x, ax_u = fig.subplots(1, 3, width_ratios=[1, 1.3, 1.3])
-        ax_p.axvspan(-1e3, 0, color="tab:green", alpha=0.12, label="stable (Re < 0)")
+        stable = ax_p.axvspan(-1e3, 0, color="tab:green", alpha=0.12, label="stable (Re < 0)")
         ol, = ax_p.plot([], [], "x", color="C3", ms=10, mew=2, label="open loop eig(A)")
         cl, = ax_p.plot([], [], "o", color="C0", ms=10, mew=2, fillstyle="none",
                         label="closed loop eig(A + B K)")
@@ -84,13 +84,14 @@ def pole_placement_explorer() -> Explorer:
         ax_p.axvline(0, color="0.5", lw=0.8)
         ax_p.set(xlim=(-12, 4), ylim=(-8, 8), xlabel="real part [1/s]", ylabel="imaginary part [rad/s]",
                  title="poles")
-        ax_p.legend(loc="lower left", fontsize="small")
+        # below the figure, where it hides no pole whatever the sliders say
+        fig.legend(handles=[stable, ol, cl], loc="outside lower center", ncols=3, fontsize="small")
         xs = [ax_x.plot([], [], label=f"x{i + 1}")[0] for i in range(3)]
         ax_x.set(xlabel="time t [s]", ylabel="state x (dimensionless)")
-        ax_x.legend(loc="upper right")
+        ax_x.legend(loc="best", fontsize="small")
         u, = ax_u.plot([], [], color="C4", label="u = K x")
         ax_u.set(xlabel="time t [s]", ylabel="control effort u", title="control effort u(t)")
-        ax_u.legend(loc="lower right")
+        ax_u.legend(loc="best", fontsize="small")
         for ax in (ax_p, ax_x, ax_u):
             ax.grid(True, alpha=0.4)
         return dict(ax_p=ax_p, ax_x=ax_x, ax_u=ax_u, ol=ol, cl=cl, xs=xs, u=u)
@@ -184,12 +185,12 @@ def upright_pendulum_explorer() -> Explorer:
         lin, = ax_th.plot([], [], color="C0", label="linear u = K(x - x*) (3.92)")
         fl, = ax_th.plot([], [], color="C1", ls="--", label="feedback linearizing (3.154)")
         ax_th.axhline(0, color="0.5", lw=0.8)
-        ax_th.set(xlabel="time t [s]", ylabel="angle from upright theta - pi [deg]")
-        ax_th.legend(loc="lower right")
-        ulin, = ax_u.plot([], [], color="C0", label="linear")
-        ufl, = ax_u.plot([], [], color="C1", ls="--", label="feedback linearizing")
+        ax_th.set(xlabel="time t [s]", ylabel="theta - pi [deg]")
+        ulin, = ax_u.plot([], [], color="C0")
+        ufl, = ax_u.plot([], [], color="C1", ls="--")
         ax_u.set(xlabel="time t [s]", ylabel="torque u [N m]", title="control torque")
-        ax_u.legend(loc="upper right")
+        # one legend for both axes, below them, where it hides no curve
+        fig.legend(handles=[lin, fl], loc="outside lower center", ncols=2, fontsize="small")
         for ax in (ax_th, ax_u):
             ax.grid(True, alpha=0.4)
         return dict(ax_th=ax_th, ax_u=ax_u, lin=lin, fl=fl, ulin=ulin, ufl=ufl)
@@ -245,16 +246,16 @@ def integral_action_explorer() -> Explorer:
     """Sliders for the disturbance size and the integral pole: offset with and without integrator."""
     def draw(fig):
         ax_y, ax_u = fig.subplots(1, 2)
-        plain, = ax_y.plot([], [], color="C0", label="u = K x (offset 3.109)")
-        integ, = ax_y.plot([], [], color="C2", label="with integral action (3.117)")
-        off = ax_y.axhline(0, color="C0", ls=":", label="predicted offset")
+        plain, = ax_y.plot([], [], color="C0", label="state feedback u = K x (offset 3.109)")
+        integ, = ax_y.plot([], [], color="C2", label="with integral action u = K x + k_I int x1 (3.117)")
+        off = ax_y.axhline(0, color="C0", ls=":", label="predicted offset (3.109)")
         ax_y.axvline(1.0, color="0.5", ls="--", lw=0.8)
         ax_y.set(xlabel="time t [s]", ylabel="output y = x1")
-        ax_y.legend(loc="center right")
-        uplain, = ax_u.plot([], [], color="C0", label="u = K x")
-        uint, = ax_u.plot([], [], color="C2", label="u = K x + k_I int x1")
+        uplain, = ax_u.plot([], [], color="C0")
+        uint, = ax_u.plot([], [], color="C2")
         ax_u.set(xlabel="time t [s]", ylabel="control input u", title="control input (integral action ends at u = -d)")
-        ax_u.legend(loc="upper left")
+        # one legend for both axes, below them, where it hides no curve
+        fig.legend(handles=[plain, integ, off], loc="outside lower center", ncols=2, fontsize="small")
         for ax in (ax_y, ax_u):
             ax.grid(True, alpha=0.4)
         return dict(ax_y=ax_y, ax_u=ax_u, plain=plain, integ=integ, off=off, uplain=uplain, uint=uint)

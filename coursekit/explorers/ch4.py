@@ -85,7 +85,7 @@ def _two_state_axes(fig, measured_label: str):
     ax_v.set_xlabel("time t [s]")
     for ax in (ax_p, ax_v):
         ax.grid(True, alpha=0.4)
-        ax.legend(loc="upper right", fontsize="small")
+        ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     return dict(ax_p=ax_p, ax_v=ax_v, meas=meas, true_p=true_p, est_p=est_p, true_v=true_v, est_v=est_v)
 
 
