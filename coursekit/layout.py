@@ -5,8 +5,10 @@ measures every tick label, axis label, title, legend placed outside its axes,
 colorbar and suptitle each time the figure is drawn, and sizes the margins and
 the gaps between axes to fit them. Because it measures the text as drawn, the
 layout stays right for any font size and font family: lecture mode, a serif
-font, ``font.size: 18``. Measuring costs time at every draw (about a third more
-than a draw alone); the explorers keep their slider redraws fast by other means.
+font, ``font.size: 18``. Measuring costs time at every draw (matplotlib measures
+the text of every axes twice, so a draw takes about one and a half to three times as
+long as one with fixed margins); the explorers keep their slider redraws fast by
+other means.
 
 Two things constrained layout does not do, and `fit_margins` adds: a suptitle
 or an axes title wider than the figure breaks into lines instead of running

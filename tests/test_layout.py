@@ -59,7 +59,8 @@ def test_the_checker_flags_crowded_tick_labels_of_one_axis():
 def test_the_checker_flags_a_legend_that_hides_a_curve():
     fig = ck.fit_margins(Figure(figsize=(4, 3)))
     ax = fig.subplots()
-    ax.plot(np.linspace(0, 1, 100), np.linspace(0, 1, 100), label="a long legend entry over the line")
+    ax.plot(np.linspace(0, 1, 100), np.full(100, 0.5), label="a long legend entry over the line")
+    ax.set_ylim(0, 1)
     ax.legend(loc="center")
     text_problems(fig)
     assert legend_problems(fig, covered=0.2)
