@@ -109,9 +109,13 @@ def test_snap_limits_widens_limits_set_by_hand_to_ticks_and_keeps_an_inverted_ax
     ax.set_xlim(-11.3, 4.0)
     ax.set_ylim(7.3, -7.3)
     snap_limits(ax)
-    assert ax.get_xlim() == pytest.approx((-12.5, 5.0)) or ax.get_xlim()[0] <= -11.3
+    lo, hi = ax.get_xlim()
+    ticks = ax.xaxis.get_major_locator().tick_values(-11.3, 4.0)
+    first, last = ticks[ticks <= -11.3].max(), ticks[ticks >= 4.0].min()     # the ticks around
+    pad = 0.05 * (last - first)                                              # plus the margin
+    assert (lo, hi) == pytest.approx((first - pad, last + pad)) and first < -11.3
     lo, hi = ax.get_ylim()
-    assert lo > hi and lo >= 7.3 and hi <= -7.3
+    assert lo > hi and lo > 7.3 and hi < -7.3
 
 
 def test_snap_limits_on_a_log_axis_stays_finite():
@@ -180,3 +184,13 @@ def test_encode_png_drops_alpha_only_when_every_pixel_is_opaque():
     rgba[0, 0, 3] = 0
     see_through = _pixels(encode_png(rgba, 100))
     assert see_through.shape == (6, 5, 4) and see_through[0, 0, 3] == 0
+
+
+def test_snapping_limits_set_by_hand_again_does_not_widen_them():
+    ax = Figure().subplots()
+    ax.set_xlim(-8.0, 8.0)
+    done = snap_limits(ax)
+    for _ in range(3):
+        assert snap_limits(ax, done=done) == done
+    ax.set_xlim(-8.0, 8.0)              # set again by hand (an update): snapped again, alike
+    assert snap_limits(ax, done=done) == done

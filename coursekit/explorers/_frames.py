@@ -62,31 +62,41 @@ def _with_margin(axis, lo: float, hi: float, margin: float) -> tuple[float, floa
     return tuple(scale.inverted().transform([a - pad, b + pad]))
 
 
-def snap_limits(ax) -> None:
+def snap_limits(ax, *, done=None) -> dict:
     """Put the view limits of `ax` on round numbers that change in steps, not continuously.
 
-    An autoscaled axis gets its data range widened to the nearest major ticks
-    (the axis' own locator, linear or log alike) plus the axes' usual margin;
-    an axis with limits set by hand gets those limits widened to the nearest
-    ticks. Either way the limits stay put while the data move between ticks.
-    An axes with a fixed aspect ratio then widens one of them, as it would when drawn.
+    The data range of an autoscaled axis, or the limits of an axis set by hand,
+    are widened to the nearest major ticks (the axis' own locator, linear or log
+    alike) plus the axes' usual margin, so that no tick label sits on a corner.
+    The limits then stay put while the data move between ticks. An axes with a
+    fixed aspect ratio then widens one of them, as it would when drawn.
+
+    `done` is what the previous call returned: limits set by hand that are still
+    the snapped ones are left as they are (snapping them again would widen them
+    at every call). Returns the limits now, by axis name.
     """
-    margins = ax.margins()
-    pairs = ((ax.xaxis, ax.get_xlim, ax.set_xlim, ax.get_autoscalex_on(), ax.dataLim.intervalx, margins[0]),
-             (ax.yaxis, ax.get_ylim, ax.set_ylim, ax.get_autoscaley_on(), ax.dataLim.intervaly, margins[1]))
-    for axis, get, set_, auto, data, margin in pairs:
+    done = done or {}
+    margins = dict(zip("xy", ax.margins()))
+    for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+        get, set_ = getattr(ax, f"get_{name}lim"), getattr(ax, f"set_{name}lim")
+        auto = getattr(ax, f"get_autoscale{name}_on")()
+        data = getattr(ax.dataLim, f"interval{name}")
         lo, hi = get()
+        if not auto and done.get(name) == (lo, hi):
+            continue
         flipped = lo > hi
         lo, hi = sorted((lo, hi))
-        if auto and np.all(np.isfinite(data)) and data[0] < data[1]:
-            snapped = _with_margin(axis, *_outer_ticks(axis, *data), margin)
-        elif np.isfinite(lo) and np.isfinite(hi) and lo < hi:
-            snapped = _outer_ticks(axis, lo, hi)
-        else:
+        if auto:
+            if not (np.all(np.isfinite(data)) and data[0] < data[1]):
+                continue                     # no data to fit yet
+            lo, hi = data
+        elif not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
             continue
+        snapped = _with_margin(axis, *_outer_ticks(axis, lo, hi), margins[name])
         if np.all(np.isfinite(snapped)) and snapped[0] < snapped[1]:   # not on a log axis with data <= 0
             set_(snapped[::-1] if flipped else snapped, auto=None)
     ax.apply_aspect()
+    return {"x": ax.get_xlim(), "y": ax.get_ylim()}
 
 
 def _paint_area(artist, renderer):
@@ -134,6 +144,7 @@ class FrameRenderer:
         self._redraw: list = []            # drawn over the background each frame, in drawing order
         self._background = None
         self._key = None
+        self._snapped: dict = {}           # the limits snap_limits left, by axes
         self.full_draws = 0
         self.blits = 0
         self.forget_changes()
@@ -148,7 +159,7 @@ class FrameRenderer:
     def frame(self) -> bytes:
         """Snap the view limits, draw the figure (blitting if possible) and return its PNG."""
         for ax in self.fig.axes:
-            snap_limits(ax)
+            self._snapped[ax] = snap_limits(ax, done=self._snapped.get(ax))
         moving = self._changed_units()
         if self._background is None or not moving <= self._moving or self._layout_key() != self._key:
             self._full_draw(self._moving | moving)
@@ -214,11 +225,24 @@ class FrameRenderer:
         self._moving, self._redraw = (moving, redraw) if redraw is not None else (set(), [])
         for artist in self._redraw:
             artist.set_animated(True)
+        self._restart_layout()
         self.canvas.draw()
         self._background = self.canvas.copy_from_bbox(self.fig.bbox) if self._redraw else None
         self._draw_redraw_list()
         self._key = self._layout_key()
         self.full_draws += 1
+
+    def _restart_layout(self) -> None:
+        """Put each axes back in its grid cell before a layout engine places it: constrained
+        layout starts from the axes' current places (their size sets the ticks it measures),
+        so without this the figure after a drag could differ by a pixel from a fresh one."""
+        if self.fig.get_layout_engine() is None:
+            return
+        for ax in self.fig.axes:
+            spec = ax.get_subplotspec()
+            if spec is not None and ax.get_in_layout():
+                ax.set_position(spec.get_position(self.fig))
+                ax.set_in_layout(True)       # set_position takes an axes out of the layout
 
     def _blit(self) -> None:
         self.canvas.restore_region(self._background)
