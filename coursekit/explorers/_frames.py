@@ -145,6 +145,7 @@ class FrameRenderer:
         self._background = None
         self._key = None
         self._snapped: dict = {}           # the limits snap_limits left, by axes
+        self._laid_out = None              # the text shape the layout was last found for
         self.full_draws = 0
         self.blits = 0
         self.forget_changes()
@@ -225,12 +226,50 @@ class FrameRenderer:
         self._moving, self._redraw = (moving, redraw) if redraw is not None else (set(), [])
         for artist in self._redraw:
             artist.set_animated(True)
-        self._restart_layout()
-        self.canvas.draw()
+        self._draw_background()
         self._background = self.canvas.copy_from_bbox(self.fig.bbox) if self._redraw else None
         self._draw_redraw_list()
         self._key = self._layout_key()
         self.full_draws += 1
+
+    def _draw_background(self) -> None:
+        """Draw the figure; lay it out again only when the text around its axes changed shape.
+
+        Constrained layout measures every tick label and title: as much work again as the draw.
+        The margins it finds depend only on the size of that text, so while the tick labels keep
+        their shape (digits alike, a font's digits are all equally wide), the axis labels their
+        text and the titles their number of lines, the layout found before is still the one it
+        would find, and the draw goes without it.
+        """
+        engine = self.fig.get_layout_engine()
+        shape = self._text_shape()
+        if engine is None or shape != self._laid_out:
+            self._restart_layout()
+            self.canvas.draw()
+            self._laid_out = shape
+            return
+        self.fig.set_layout_engine("none")
+        try:
+            self.canvas.draw()
+        finally:
+            self.fig.set_layout_engine(engine)
+
+    def _text_shape(self):
+        """The size-relevant shape of the text a layout engine measures (see `_draw_background`)."""
+        digits = str.maketrans("0123456789", "0000000000")
+
+        def ticks(axis):
+            labels = axis.major.formatter.format_ticks(axis.major.locator())
+            return tuple(label.translate(digits) for label in labels), axis.get_offset_text().get_text()
+
+        def lines(text):
+            return text.get_text().count("\n") if text.get_text() else -1
+
+        axes = tuple((ticks(ax.xaxis), ticks(ax.yaxis), ax.get_xlabel(), ax.get_ylabel(),
+                      tuple(lines(t) for t in (ax.title, *ax.texts)), ax.get_position(original=True).bounds)
+                     for ax in self.fig.axes)
+        figure = tuple(lines(t) for t in self.fig.texts)
+        return tuple(self.fig.get_size_inches()), axes, figure
 
     def _restart_layout(self) -> None:
         """Put each axes back in its grid cell before a layout engine places it: constrained
