@@ -43,7 +43,7 @@ if importlib.util.find_spec("coursekit") is None:
         "'python -m coursekit colab' writes it into this cell.)")'''
 
 _URL = re.compile(r"^https://[A-Za-z0-9.\-]+(:[0-9]+)?/[A-Za-z0-9_.\-/~]+$")
-_CELL_URL = re.compile(r'"coursekit @ git\+([^"]+)"')
+_CELL_URL = re.compile(r'"coursekit @ git\+([^"]+)"\], check=True\)')
 
 
 def install_cell_source(repository: str | None = None) -> str:

@@ -12,7 +12,8 @@ the text changes:
 * the cells before the first section (the install cell, the environment check
   and the imports): ``skip``; they still run when the slides are built with
   ``--execute``;
-* every other cell: ``-`` (it joins the slide above).
+* every other cell: ``-`` (it joins the slide above); that is also what
+  nbconvert assumes without metadata, so these cells carry none.
 
 `apply_slide_metadata` writes these types into the notebooks (``python -m
 coursekit slides``); a test checks the stored metadata is what it would write.
@@ -61,10 +62,20 @@ def slide_types(nb) -> list[str]:
     return types
 
 
+def _stored_type(cell) -> str:
+    return cell.metadata.get("slideshow", {}).get("slide_type", "-")
+
+
 def with_slide_metadata(nb):
-    """`nb` with ``metadata.slideshow.slide_type`` set on every cell (changed in place and returned)."""
+    """`nb` with ``metadata.slideshow.slide_type`` set on every cell (changed in place and returned).
+
+    Cells of type ``-`` carry no slideshow metadata (nbconvert's default).
+    """
     for cell, kind in zip(nb.cells, slide_types(nb)):
-        cell.metadata.setdefault("slideshow", {})["slide_type"] = kind
+        if kind == "-":
+            cell.metadata.pop("slideshow", None)
+        else:
+            cell.metadata.setdefault("slideshow", {})["slide_type"] = kind
     return nb
 
 
@@ -88,8 +99,9 @@ def apply_slide_metadata(notebooks: Path | str | None = None, *, write: bool = T
     changed = []
     for path in paths:
         nb = read_notebook(path)
-        before = [cell.metadata.get("slideshow", {}).get("slide_type") for cell in nb.cells]
-        if before != slide_types(nb):
+        stored = [_stored_type(cell) for cell in nb.cells]
+        explicit_dash = any(cell.metadata.get("slideshow", {}).get("slide_type") == "-" for cell in nb.cells)
+        if stored != slide_types(nb) or explicit_dash:
             changed.append(path)
             if write:
                 write_notebook(with_slide_metadata(nb), path)
