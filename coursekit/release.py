@@ -66,8 +66,14 @@ def _nbformat():
 
 
 def default_notebook_dir() -> Path:
-    """The repository's ``notebooks/`` folder (the instructor edition), next to the package."""
-    return Path(__file__).resolve().parents[1] / "notebooks"
+    """The repository's ``notebooks/`` folder (the instructor edition).
+
+    The folder next to the package when coursekit is installed from a clone
+    with ``pip install -e``; otherwise (``pip install .``, as on Binder)
+    ``notebooks/`` in the current folder.
+    """
+    beside = Path(__file__).resolve().parents[1] / "notebooks"
+    return beside if beside.is_dir() else Path.cwd() / "notebooks"
 
 
 def read_notebook(path: Path | str):

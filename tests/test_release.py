@@ -247,3 +247,13 @@ def test_written_notebooks_validate_and_keep_the_json_style(tmp_path):
     nbformat.validate(nbformat.read(str(path), as_version=4))
     text = Path(path).read_text(encoding="utf-8")
     assert text.startswith('{\n "cells": [\n  {\n') and text.endswith("}\n")
+
+
+def test_default_notebook_folder_without_an_editable_install(tmp_path, monkeypatch):
+    # installed with `pip install .` (Binder): the package is not beside notebooks/, the clone is the cwd
+    import coursekit.release as release
+    monkeypatch.setattr(release, "__file__", str(tmp_path / "site-packages" / "coursekit" / "release.py"))
+    monkeypatch.chdir(tmp_path)
+    assert release.default_notebook_dir() == tmp_path / "notebooks"
+    monkeypatch.undo()
+    assert release.default_notebook_dir() == Path(__file__).resolve().parents[1] / "notebooks"
