@@ -49,9 +49,8 @@ STUDENT_NOTE = ("> **Student edition.** The worked solutions of the exercises ar
 # a sentence of the exercise section that points to a solution cell, e.g. "The solution follows in
 # a collapsed cell (click the three dots to open it) — try first!"; a sentence that says the checks
 # never show the solution is kept
-_POINTER = re.compile(r"\bsolutions?\b.*\b(follow|follows|below|collapsed|click|open|after|next|hidden)\b"
-                      r"|\b(follow|follows|below|collapsed|click|open|after|next|hidden)\b.*\bsolutions?\b",
-                      re.IGNORECASE)
+_WHERE = r"(follow\w*|below|beneath|collapsed|click\w*|hidden|sits)"
+_POINTER = re.compile(rf"\bsolutions?\b.*\b{_WHERE}\b|\b{_WHERE}\b.*\bsolutions?\b", re.IGNORECASE)
 _NEGATION = re.compile(r"\b(never|not|no)\b", re.IGNORECASE)
 _SENTENCE_END = re.compile(r"(?<=[.!?])\s+(?=\S)")
 
