@@ -9,7 +9,7 @@ A notebook knows nothing of the repository it was opened from, so the
 repository's address has to be written into the cell: ``python -m coursekit
 colab`` writes the address of the git remote ``origin`` (or the one given with
 ``--repository``) into the cell of every notebook. Until that is done, the cell
-stops on Colab with a message saying what to run instead of installing.
+stops on Colab with the ``%pip install`` line to run by hand.
 """
 
 from __future__ import annotations
@@ -37,10 +37,8 @@ if importlib.util.find_spec("coursekit") is None:
 _WITHOUT_REPOSITORY = _HEADER + '''import importlib.util
 if importlib.util.find_spec("coursekit") is None:
     raise ModuleNotFoundError(
-        "coursekit is not installed in this Python. Install it from the repository these notebooks come "
-        "from, with its address in: %pip install \\"coursekit @ git+https://github.com/OWNER/NAME\\", "
-        "then run this cell again. (These notebooks do not name their repository yet: the maintainer's "
-        "'python -m coursekit colab' writes it into this cell.)")'''
+        'coursekit is missing: run %pip install "coursekit @ git+https://github.com/OWNER/NAME" with '
+        "the address of the repository these notebooks come from, then run this cell again.")'''
 
 _URL = re.compile(r"^https://[A-Za-z0-9.\-]+(:[0-9]+)?/[A-Za-z0-9_.\-/~]+$")
 _CELL_URL = re.compile(r'"coursekit @ git\+([^"]+)"\], check=True\)')
