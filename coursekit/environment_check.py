@@ -41,12 +41,13 @@ MINIMUM_VERSIONS = {
     "sympy": "1.12",
     "matplotlib": "3.8",
     "ipywidgets": "8.0",
+    "anywidget": "0.9",
     "jupyterlab": "4.0",
 }
 MINIMUM_PYTHON = (3, 10)
 
 #: packages that are reported when installed but not required in the kernel
-_OPTIONAL = ("jupyterlab", "ipykernel", "anywidget", "coursekit")
+_OPTIONAL = ("jupyterlab", "ipykernel", "coursekit")
 
 #: the JupyterLab front-end of ipywidgets and the first major version that speaks ipywidgets 8
 _MANAGER = ("@jupyter-widgets", "jupyterlab-manager")
@@ -205,7 +206,10 @@ def _frontend_warnings(frontend: str | None, ipywidgets: str | None) -> list[str
 
 
 def _anywidget_warnings(anywidget: str | None) -> list[str]:
-    """anywidget installed in the kernel but its JupyterLab extension not found: figures stay blank."""
+    """anywidget installed in the kernel but its JupyterLab extension not found: figures stay blank.
+
+    (A missing anywidget is reported with the other required packages.)
+    """
     if anywidget is None or _find_labextension(_ANYWIDGET, None) is not None:
         return []
     return [f"anywidget {anywidget} is installed in the kernel but its JupyterLab extension was not found: "

@@ -51,6 +51,7 @@ STUDENT_NOTE = ("> **Student edition.** The worked solutions of the exercises ar
 # never show the solution is kept
 _WHERE = r"(follow\w*|below|beneath|collapsed|click\w*|hidden|sits)"
 _POINTER = re.compile(rf"\bsolutions?\b.*\b{_WHERE}\b|\b{_WHERE}\b.*\bsolutions?\b", re.IGNORECASE)
+_TRY_FIRST = re.compile(r"^\W*try\b[\w ]{0,25}\bfirst\W*$", re.IGNORECASE)
 _NEGATION = re.compile(r"\b(never|not|no)\b", re.IGNORECASE)
 _SENTENCE_END = re.compile(r"(?<=[.!?])\s+(?=\S)")
 
@@ -90,11 +91,17 @@ def _is_solution(cell) -> bool:
 
 
 def _without_solution_pointers(text: str) -> str:
-    """`text` minus the sentences that point to a solution cell (paragraph by paragraph)."""
+    """`text` minus the sentences that point to a solution cell (paragraph by paragraph).
+
+    Where such a sentence goes, a short "Try first!" of the same paragraph
+    (about the solution that is no longer there) goes with it.
+    """
     paragraphs = []
     for paragraph in text.split("\n\n"):
         sentences = _SENTENCE_END.split(paragraph)
         kept = [s for s in sentences if not (_POINTER.search(s) and not _NEGATION.search(s))]
+        if len(kept) < len(sentences):
+            kept = [s for s in kept if not _TRY_FIRST.match(s)]
         if kept:
             paragraphs.append(" ".join(kept) if len(kept) < len(sentences) else paragraph)
     return "\n\n".join(paragraphs)

@@ -172,9 +172,10 @@ def test_anywidget_without_its_labextension_warns(monkeypatch, tmp_path):
     assert ck.check_environment(show=False).ok
 
 
-def test_no_anywidget_no_anywidget_warning(monkeypatch, tmp_path):
+def test_missing_anywidget_is_reported_once_as_a_missing_package(monkeypatch, tmp_path):
     _forget_host(monkeypatch)
     _labextension(tmp_path, "@jupyter-widgets/jupyterlab-manager", "5.0.9")
     monkeypatch.setattr(envc, "_labextension_dirs", lambda: [tmp_path])
     _fake_versions(monkeypatch, anywidget=None)
-    assert ck.check_environment(show=False).ok
+    warnings = ck.check_environment(show=False).warnings
+    assert len(warnings) == 1 and warnings[0].startswith("anywidget is not installed"), warnings

@@ -192,7 +192,8 @@ def _notebook():
                          execution_count=3),
         v4.new_markdown_cell("## Exercises\n\nType your answer and run the cell. It never shows the "
                              "solution. The worked solution sits in a collapsed box below each exercise "
-                             "— try first!\n\nGood luck.", metadata={"coursekit": "exercise"}),
+                             "— try first!\n\nClick **Solution** to unfold a worked solution. Try it "
+                             "first!\n\nTry the first exercise now.", metadata={"coursekit": "exercise"}),
         v4.new_code_cell("answer = None\nprint('Not yet')", metadata={"coursekit": "exercise"}),
         v4.new_markdown_cell("<details><summary>Solution</summary>\n\n```python\nanswer = 1\n```\n"
                              "</details>", metadata={"tags": ["solution"], "coursekit": "exercise"}),
@@ -218,7 +219,7 @@ def test_student_edition_clears_outputs_and_widget_state():
 def test_student_edition_drops_only_the_sentences_that_point_to_a_solution():
     text = student_edition(_notebook()).cells[2].source
     assert text == ("## Exercises\n\nType your answer and run the cell. It never shows the solution."
-                    "\n\nGood luck.")
+                    "\n\nTry the first exercise now.")
 
 
 def test_student_edition_is_idempotent_and_notes_once():
