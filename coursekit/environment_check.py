@@ -6,6 +6,17 @@ in the notebook: a package older than the supported lower bound (the bounds of
 ``pyproject.toml``), or a JupyterLab without the ipywidgets front-end (the
 sliders would show as text such as ``VBox(children=...``).
 
+Where the notebook runs decides how the widget front-end can be checked:
+
+* a JupyterLab of your own, or on Binder (repo2docker installs the kernel and
+  the JupyterLab server in one environment): the front-end is a JupyterLab
+  extension whose ``package.json`` the kernel can read, so it is checked;
+* Google Colab: Colab draws widgets with its own widget manager, not with
+  JupyterLab extensions, so there is nothing to look for and no warning;
+* JupyterLite (Pyodide, ``sys.platform == "emscripten"``): the extensions live
+  in the web site, out of the kernel's reach, so the check says it cannot tell
+  instead of warning.
+
 Versions are read from the installed package metadata, so the check imports
 none of the heavy libraries and runs in milliseconds.
 """
@@ -20,7 +31,8 @@ from pathlib import Path
 
 from ._validation import as_flag
 
-__all__ = ["check_environment", "EnvironmentReport", "MINIMUM_VERSIONS", "find_widget_frontend"]
+__all__ = ["check_environment", "EnvironmentReport", "MINIMUM_VERSIONS", "find_widget_frontend",
+           "detect_host"]
 
 #: lower bounds of pyproject.toml (dependencies and the dev extra); a test keeps them in sync
 MINIMUM_VERSIONS = {
@@ -29,6 +41,7 @@ MINIMUM_VERSIONS = {
     "sympy": "1.12",
     "matplotlib": "3.8",
     "ipywidgets": "8.0",
+    "anywidget": "0.9",
     "jupyterlab": "4.0",
 }
 MINIMUM_PYTHON = (3, 10)
@@ -39,6 +52,16 @@ _OPTIONAL = ("jupyterlab", "ipykernel", "coursekit")
 #: the JupyterLab front-end of ipywidgets and the first major version that speaks ipywidgets 8
 _MANAGER = ("@jupyter-widgets", "jupyterlab-manager")
 _MANAGER_MIN_MAJOR = 5
+#: the JupyterLab extension of anywidget (checked when anywidget is installed in the kernel)
+_ANYWIDGET = ("anywidget",)
+
+# what `detect_host` returns, with the text the report prints for each
+_HOSTS = {
+    "jupyter": "local Jupyter or Python",
+    "binder": "Binder",
+    "colab": "Google Colab",
+    "jupyterlite": "JupyterLite (Pyodide)",
+}
 
 
 @dataclass
@@ -49,6 +72,7 @@ class EnvironmentReport:
     versions: dict[str, str | None]
     widget_frontend: str | None
     warnings: list[str] = field(default_factory=list)
+    host: str = "jupyter"
 
     @property
     def ok(self) -> bool:
@@ -109,19 +133,41 @@ def _labextension_dirs() -> list[Path]:
     return dirs
 
 
+def detect_host() -> str:
+    """Where this kernel runs: ``"colab"``, ``"jupyterlite"``, ``"binder"`` or ``"jupyter"``.
+
+    Colab is recognised by its ``google.colab`` module, which Colab's kernel
+    imports at start; JupyterLite by Pyodide's platform ``emscripten``; Binder
+    by the ``BINDER_*`` variables BinderHub sets in the session's environment.
+    Anything else is a Jupyter server of one's own.
+    """
+    if "google.colab" in sys.modules:
+        return "colab"
+    if sys.platform == "emscripten":
+        return "jupyterlite"
+    if any(name in os.environ for name in ("BINDER_LAUNCH_HOST", "BINDER_REQUEST", "BINDER_REPO_URL")):
+        return "binder"
+    return "jupyter"
+
+
 def find_widget_frontend(dirs: list[Path] | None = None) -> str | None:
     """Version of the installed ``@jupyter-widgets/jupyterlab-manager`` labextension, or None.
 
     `dirs` is a list of labextension directories to search (default: the
     current environment's); a ValueError says so when it is anything else.
     """
+    return _find_labextension(_MANAGER, dirs)
+
+
+def _find_labextension(name: tuple[str, ...], dirs: list[Path] | None) -> str | None:
+    """Version in ``<dir>/<name>/package.json`` for the first directory that has it, or None."""
     if dirs is not None and (isinstance(dirs, (str, bytes, Path)) or not isinstance(dirs, (list, tuple))
                              or not all(isinstance(d, (str, Path)) for d in dirs)):
         raise ValueError(f"dirs must be a list of directories (paths): received {dirs!r}; "
                          "wrap a single directory in a list, [Path(...)].")
     dirs = None if dirs is None else [Path(d) for d in dirs]
     for base in dirs if dirs is not None else _labextension_dirs():
-        package = base.joinpath(*_MANAGER, "package.json")
+        package = base.joinpath(*name, "package.json")
         if package.is_file():
             try:
                 return str(json.loads(package.read_text(encoding="utf-8")).get("version", "unknown"))
@@ -159,15 +205,44 @@ def _frontend_warnings(frontend: str | None, ipywidgets: str | None) -> list[str
     return []
 
 
+def _anywidget_warnings(anywidget: str | None) -> list[str]:
+    """anywidget installed in the kernel but its JupyterLab extension not found: figures stay blank.
+
+    (A missing anywidget is reported with the other required packages.)
+    """
+    if anywidget is None or _find_labextension(_ANYWIDGET, None) is not None:
+        return []
+    return [f"anywidget {anywidget} is installed in the kernel but its JupyterLab extension was not found: "
+            "the explorers' figures will stay blank. Fix: python -m pip install -U anywidget in the "
+            "environment JupyterLab runs from, then restart JupyterLab and reload the browser tab."]
+
+
+def _widget_checks(host: str, versions: dict[str, str | None]) -> tuple[str | None, list[str]]:
+    """(front-end description, warnings) for the widget front-end on this host."""
+    if host == "colab":
+        return "Colab's own widget manager", []
+    if host == "jupyterlite":
+        return "not checkable from a JupyterLite kernel", []
+    frontend = find_widget_frontend()
+    warnings = _frontend_warnings(frontend, versions.get("ipywidgets"))
+    if frontend is not None:
+        warnings += _anywidget_warnings(versions.get("anywidget"))
+    return frontend, warnings
+
+
 def check_environment(*, show: bool = True) -> EnvironmentReport:
     """Print Python's and the course packages' versions and warn about what will break.
 
     Warns (with the command that fixes it) when a package is older than the
     lower bound of ``pyproject.toml`` or missing, when Python is older than
-    3.10, and when the JupyterLab front-end of ipywidgets is not installed.
-    Returns an `EnvironmentReport`; ``show=False`` only builds it.
+    3.10, and when the JupyterLab front-end of ipywidgets (or of anywidget,
+    when that is installed) is not found. On Colab and JupyterLite the
+    front-end is not a JupyterLab extension the kernel can see, so it is not
+    looked for there (see the module docstring). Returns an
+    `EnvironmentReport`; ``show=False`` only builds it.
     """
     show = as_flag(show, "show")
+    host = detect_host()
     names = [*MINIMUM_VERSIONS, *(n for n in _OPTIONAL if n not in MINIMUM_VERSIONS)]
     versions = {name: _installed_version(name) for name in names}
     python = ".".join(map(str, sys.version_info[:3]))
@@ -176,20 +251,20 @@ def check_environment(*, show: bool = True) -> EnvironmentReport:
         warnings.append(f"Python {python} is older than 3.10: make a new environment with Python 3.10 "
                         "or newer (see environment.md).")
     warnings += _version_warnings(versions)
-    frontend = find_widget_frontend()
-    warnings += _frontend_warnings(frontend, versions.get("ipywidgets"))
+    frontend, widget_warnings = _widget_checks(host, versions)
     report = EnvironmentReport(python=python, versions=versions, widget_frontend=frontend,
-                               warnings=warnings)
+                               warnings=warnings + widget_warnings, host=host)
     if show:
         _print_report(report)
     return report
 
 
 def _print_report(report: EnvironmentReport) -> None:
-    print(f"Python {report.python}")
+    print(f"Python {report.python} ({_HOSTS[report.host]})")
     for name, version in report.versions.items():
         print(f"  {name:<11} {version or 'not installed'}")
-    print(f"  {'widgets UI':<11} {report.widget_frontend or 'not found'}  (JupyterLab front-end of ipywidgets)")
+    where = "" if report.host in ("colab", "jupyterlite") else "  (JupyterLab front-end of ipywidgets)"
+    print(f"  {'widgets UI':<11} {report.widget_frontend or 'not found'}{where}")
     if report.ok:
         print("Environment OK.")
     for message in report.warnings:

@@ -93,3 +93,89 @@ def test_minimum_versions_match_pyproject():
 def test_show_must_be_bool():
     with pytest.raises(ValueError, match="show must be True or False"):
         ck.check_environment(show="yes")
+
+
+# -- where the kernel runs: Colab, JupyterLite, Binder (simulated) -------------------------------
+
+def _no_frontend_anywhere(monkeypatch, tmp_path):
+    """No labextension directory holds anything: what a kernel without a JupyterLab extension sees."""
+    monkeypatch.setattr(envc, "_labextension_dirs", lambda: [tmp_path])
+
+
+def _forget_host(monkeypatch):
+    for name in ("BINDER_LAUNCH_HOST", "BINDER_REQUEST", "BINDER_REPO_URL"):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.delitem(sys.modules, "google.colab", raising=False)
+
+
+def test_host_is_local_jupyter_here(monkeypatch):
+    _forget_host(monkeypatch)
+    assert envc.detect_host() == "jupyter"
+
+
+def test_colab_does_not_warn_about_the_jupyterlab_frontend(monkeypatch, tmp_path, capsys):
+    _forget_host(monkeypatch)
+    _no_frontend_anywhere(monkeypatch, tmp_path)
+    monkeypatch.setitem(sys.modules, "google.colab", type(sys)("google.colab"))
+    report = ck.check_environment()
+    out = capsys.readouterr().out
+    assert report.host == "colab"
+    assert report.ok, report.warnings
+    assert "(Google Colab)" in out and "Colab's own widget manager" in out
+    assert "WARNING" not in out
+
+
+def test_jupyterlite_does_not_warn_and_says_it_cannot_tell(monkeypatch, tmp_path, capsys):
+    _forget_host(monkeypatch)
+    _no_frontend_anywhere(monkeypatch, tmp_path)
+    monkeypatch.setattr(sys, "platform", "emscripten")
+    report = ck.check_environment()
+    out = capsys.readouterr().out
+    assert report.host == "jupyterlite" and report.ok, report.warnings
+    assert "not checkable from a JupyterLite kernel" in out
+
+
+def test_binder_still_checks_the_frontend(monkeypatch, tmp_path):
+    # Binder runs JupyterLab from the kernel's environment: a missing front-end is a real problem there
+    _forget_host(monkeypatch)
+    monkeypatch.setenv("BINDER_LAUNCH_HOST", "https://binder.example/")
+    assert envc.detect_host() == "binder"
+    assert ck.check_environment(show=False).ok   # the dev environment has the front-end
+    _no_frontend_anywhere(monkeypatch, tmp_path)
+    report = ck.check_environment(show=False)
+    assert report.host == "binder"
+    assert any("jupyterlab-manager) was not found" in w for w in report.warnings)
+
+
+def test_colab_still_warns_about_old_packages(monkeypatch):
+    _forget_host(monkeypatch)
+    monkeypatch.setitem(sys.modules, "google.colab", type(sys)("google.colab"))
+    _fake_versions(monkeypatch, ipywidgets="7.7.1")
+    warnings = ck.check_environment(show=False).warnings
+    assert any("ipywidgets 7.7.1 is older than the supported 8.0" in w for w in warnings)
+
+
+def _labextension(base, name, version):
+    pkg = base.joinpath(*name.split("/"))
+    pkg.mkdir(parents=True)
+    (pkg / "package.json").write_text(json.dumps({"name": name, "version": version}))
+
+
+def test_anywidget_without_its_labextension_warns(monkeypatch, tmp_path):
+    _forget_host(monkeypatch)
+    _labextension(tmp_path, "@jupyter-widgets/jupyterlab-manager", "5.0.9")
+    monkeypatch.setattr(envc, "_labextension_dirs", lambda: [tmp_path])
+    _fake_versions(monkeypatch, anywidget="0.9.13")
+    assert any("anywidget 0.9.13 is installed in the kernel but its JupyterLab extension was not found"
+               in w for w in ck.check_environment(show=False).warnings)
+    _labextension(tmp_path, "anywidget", "0.9.13")
+    assert ck.check_environment(show=False).ok
+
+
+def test_missing_anywidget_is_reported_once_as_a_missing_package(monkeypatch, tmp_path):
+    _forget_host(monkeypatch)
+    _labextension(tmp_path, "@jupyter-widgets/jupyterlab-manager", "5.0.9")
+    monkeypatch.setattr(envc, "_labextension_dirs", lambda: [tmp_path])
+    _fake_versions(monkeypatch, anywidget=None)
+    warnings = ck.check_environment(show=False).warnings
+    assert len(warnings) == 1 and warnings[0].startswith("anywidget is not installed"), warnings

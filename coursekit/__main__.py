@@ -1,0 +1,133 @@
+"""Instructor tools on the command line: ``python -m coursekit COMMAND ...``.
+
+Each command is one small function ``_add_<command>(commands)`` that adds its
+parser to the subparsers `commands` and sets ``run`` to a function taking the
+parsed arguments and returning the exit status; `COMMANDS` lists them in the
+order ``--help`` shows them. The work itself lives in a module of the package
+(`coursekit.release`, `coursekit.slides`, ...) whose functions take paths, so
+the same work is done from Python and tested there.
+
+A bad argument (a folder that is not empty, a missing notebooks folder) stops
+with ``coursekit COMMAND: error: ...`` and exit status 2, as argparse does for
+its own errors.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+__all__ = ["main", "build_parser", "COMMANDS"]
+
+
+def _add_release(commands) -> None:
+    parser = commands.add_parser(
+        "release", help="write the student edition of the notebooks (no worked solutions)",
+        description="Write the student edition of the course notebooks into a folder: every cell "
+                    "tagged 'solution' removed, outputs cleared, the exercises and their check_* cells "
+                    "kept, and a note in the first cell saying the worked solutions are in the "
+                    "instructor edition. The edition runs top to bottom without errors.")
+    parser.add_argument("--out", required=True, type=Path, metavar="DIR",
+                        help="folder to write the notebooks to (created when missing; must be empty "
+                             "unless --force is given)")
+    parser.add_argument("--notebooks", type=Path, default=None, metavar="DIR",
+                        help="folder of the instructor notebooks (default: the repository's notebooks/)")
+    parser.add_argument("--force", action="store_true",
+                        help="write into a non-empty --out folder, overwriting notebooks of the same "
+                             "names (other files there are left alone)")
+    parser.set_defaults(run=_run_release)
+
+
+def _run_release(args) -> int:
+    from .release import build_release
+    written = build_release(args.out, notebooks=args.notebooks, force=args.force)
+    print(f"student edition: {len(written)} notebooks written to {args.out}")
+    for path in written:
+        print(f"  {path.name}")
+    return 0
+
+
+def _add_slides(commands) -> None:
+    parser = commands.add_parser(
+        "slides", help="set the slide metadata of the notebooks (for nbconvert --to slides)",
+        description="Give every cell of the course notebooks its slide type, so that "
+                    "'jupyter nbconvert --to slides' makes one slide per section (## heading) and a "
+                    "sub-slide per subsection (### heading) and per paragraph with its code. Rewrites "
+                    "the notebooks in place; --check only reports the notebooks that are out of date.")
+    parser.add_argument("--notebooks", type=Path, default=None, metavar="DIR",
+                        help="folder of the notebooks (default: the repository's notebooks/)")
+    parser.add_argument("--check", action="store_true",
+                        help="change nothing; exit with status 1 when a notebook's slide metadata is "
+                             "out of date")
+    parser.set_defaults(run=_run_slides)
+
+
+def _run_slides(args) -> int:
+    from .slides import apply_slide_metadata
+    changed = apply_slide_metadata(args.notebooks, write=not args.check)
+    if args.check:
+        for path in changed:
+            print(f"slide metadata out of date: {path.name} (run: python -m coursekit slides)")
+        return 1 if changed else 0
+    print(f"slide metadata updated in {len(changed)} notebook(s)" if changed else
+          "slide metadata already up to date")
+    return 0
+
+
+def _add_colab(commands) -> None:
+    parser = commands.add_parser(
+        "colab", help="write the repository's address into the notebooks' install cell (for Colab)",
+        description="Colab opens a notebook without the rest of the repository, so the first code cell "
+                    "of every notebook installs coursekit from the repository where it is missing. This "
+                    "writes the repository's https address into that cell (it does nothing where "
+                    "coursekit is installed). Default address: the git remote 'origin'.")
+    parser.add_argument("--repository", default=None, metavar="URL",
+                        help="https address of the course repository, e.g. https://github.com/OWNER/NAME "
+                             "(default: the address of the git remote 'origin')")
+    parser.add_argument("--notebooks", type=Path, default=None, metavar="DIR",
+                        help="folder of the notebooks (default: the repository's notebooks/)")
+    parser.set_defaults(run=_run_colab)
+
+
+def _run_colab(args) -> int:
+    from .colab import apply_install_cell, repository_from_git
+    from .release import default_notebook_dir
+    folder = args.notebooks or default_notebook_dir()
+    repository = args.repository or repository_from_git(folder)
+    if repository is None:
+        raise ValueError("no --repository given and the git remote 'origin' has no https or ssh address; "
+                         "pass --repository https://github.com/OWNER/NAME")
+    changed = apply_install_cell(folder, repository=repository)
+    print(f"install cell now installs from {repository}: {len(changed)} notebook(s) changed")
+    return 0
+
+
+#: one function per command, in the order of --help
+COMMANDS = (_add_release, _add_slides, _add_colab)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The ``python -m coursekit`` parser with one subcommand per entry of `COMMANDS`."""
+    parser = argparse.ArgumentParser(
+        prog="python -m coursekit",
+        description="Instructor tools of the coursekit course companion. "
+                    "Run 'python -m coursekit COMMAND --help' for the options of a command.")
+    commands = parser.add_subparsers(title="commands", dest="command", metavar="COMMAND", required=True)
+    for add in COMMANDS:
+        add(commands)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Parse `argv` (default: the command line), run the command and return its exit status."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        return args.run(args)
+    except (ValueError, OSError) as error:
+        parser.exit(2, f"{parser.prog} {args.command}: error: {error}\n")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
