@@ -343,22 +343,25 @@ html_theme_options = {{
     "navigation_with_keys": False,
 }}
 html_show_sourcelink = False
-html_context = {"default_mode": "light"}   # the theme logs an error when no mode is stored
+html_context = {{"default_mode": "light"}}   # the theme logs an error when no mode is stored
 html_copy_source = False
 """
 
 
 def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: int = 600,
-               readme=None) -> Path:
+               readme=None, verbose: bool = False) -> Path:
     """Build the course website into `out_dir` and return the path of its ``index.html``.
 
     `student=True` builds it from the student edition (no solutions). `notebooks_dir` defaults to
     the repository's ``notebooks/``; `timeout` is the limit in seconds for one notebook cell;
     `readme` (default: the repository's README.md, if present) supplies an optional "Run online"
-    section for the landing page. `out_dir` is replaced by the new site.
+    section for the landing page; `verbose=True` prints each step to stderr. `out_dir` is
+    replaced by the new site.
     """
     if not isinstance(student, bool):
         raise TypeError(f"student must be True or False, got {student!r}")
+    if not isinstance(verbose, bool):
+        raise TypeError(f"verbose must be True or False, got {verbose!r}")
     if not isinstance(timeout, int) or isinstance(timeout, bool) or timeout <= 0:
         raise ValueError(f"timeout must be a positive whole number of seconds, got {timeout!r}")
     out = Path(out_dir).resolve()
@@ -372,14 +375,23 @@ def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: i
     with tempfile.TemporaryDirectory(prefix="coursekit-site-") as tmp:
         src = Path(tmp) / "src"
         src.mkdir()
-        chapters = [_prepare(path, src, student=student, timeout=timeout) for path in sources]
+        chapters = []
+        for path in sources:
+            _say(verbose, f"executing {path.name}")
+            chapters.append(_prepare(path, src, student=student, timeout=timeout))
         _write_sources(src, chapters, student=student, readme=readme)
         html = Path(tmp) / "html"
+        _say(verbose, "building the HTML pages with Sphinx")
         _run_sphinx(src, html)
         if out.exists():
             shutil.rmtree(out)
         shutil.copytree(html, out)
     return out / "index.html"
+
+
+def _say(verbose: bool, message: str) -> None:
+    if verbose:
+        print(f"coursekit site: {message}", file=sys.stderr, flush=True)
 
 
 def _prepare(path: Path, src: Path, *, student: bool, timeout: int) -> dict:
