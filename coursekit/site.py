@@ -21,8 +21,10 @@ need them.
 
 from __future__ import annotations
 
+import concurrent.futures
 import copy
 import importlib.util
+import multiprocessing
 import os
 import re
 import shutil
@@ -71,6 +73,9 @@ html[data-theme="dark"] div.admonition.erratum > .admonition-title { background:
 details.solution, .cell details.hide, section details {
   margin: 0.5em 0 1em 0;
 }
+/* the book theme keeps the sidebar toggle and the search in its own bars; newer releases of the
+   pydata-sphinx-theme below it add a second, empty top bar that repeats the search field */
+#pst-header { display: none; }
 section details > summary {
   cursor: pointer;
   font-weight: 600;
@@ -375,10 +380,7 @@ def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: i
     with tempfile.TemporaryDirectory(prefix="coursekit-site-") as tmp:
         src = Path(tmp) / "src"
         src.mkdir()
-        chapters = []
-        for path in sources:
-            _say(verbose, f"executing {path.name}")
-            chapters.append(_prepare(path, src, student=student, timeout=timeout))
+        chapters = _prepare_all(sources, src, student=student, timeout=timeout, verbose=verbose)
         _write_sources(src, chapters, student=student, readme=readme)
         html = Path(tmp) / "html"
         _say(verbose, "building the HTML pages with Sphinx")
@@ -392,6 +394,22 @@ def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: i
 def _say(verbose: bool, message: str) -> None:
     if verbose:
         print(f"coursekit site: {message}", file=sys.stderr, flush=True)
+
+
+def _prepare_all(sources: list[Path], src: Path, *, student: bool, timeout: int,
+                 verbose: bool) -> list[dict]:
+    """Prepare every notebook, one worker process (and kernel) per core, in chapter order."""
+    workers = max(1, min(len(sources), os.cpu_count() or 1))
+    _say(verbose, f"executing {len(sources)} notebooks, {workers} at a time")
+    context = multiprocessing.get_context("spawn")
+    with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+        futures = [pool.submit(_prepare, path, src, student=student, timeout=timeout)
+                   for path in sources]
+        chapters = []
+        for path, future in zip(sources, futures):
+            chapters.append(future.result())
+            _say(verbose, f"executed {path.name}")
+    return chapters
 
 
 def _prepare(path: Path, src: Path, *, student: bool, timeout: int) -> dict:

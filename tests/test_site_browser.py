@@ -176,7 +176,8 @@ PAGE_REPORT = """() => {
     'script[type*="widget"], .jupyter-widgets, .widget-area, .jp-OutputArea-output:empty').length;
   const headings = [...article.querySelectorAll('h1, h2, h3, h4')]
                      .map(h => h.textContent.replace(/#$/, '').trim());
-  return {broken, untypeset, rawTex, widgets, headings, math: math.length};
+  const searchFields = [...document.querySelectorAll('.search-button-field')].filter(e => e.checkVisibility()).length;
+  return {broken, untypeset, rawTex, widgets, headings, searchFields, math: math.length};
 }"""
 
 EXPLORER_REPORT = """() => [...document.querySelectorAll('.cell')]
@@ -235,6 +236,7 @@ def test_page_loads_offline_with_images_and_typeset_math(name, edition, server, 
     assert report["untypeset"] == [], f"equations not typeset: {report['untypeset'][:5]}"
     assert report["rawTex"] == [], f"TeX or markdown left in the text: {report['rawTex'][:5]}"
     assert report["widgets"] == 0, "an empty widget area is on the page"
+    assert report["searchFields"] <= 1, "the search field is shown twice (a second top bar)"
     if name in CHAPTERS:
         _check_chapter(v, name, report)
 
