@@ -48,7 +48,8 @@ __all__ = [
 
 WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
 SITE_TOOLS = {"sphinx": "sphinx", "myst_nb": "myst-nb", "sphinx_book_theme": "sphinx-book-theme",
-              "sphinx-mathjax-offline": "sphinx-mathjax-offline", "nbclient": "nbclient"}
+              "sphinx-mathjax-offline": "sphinx-mathjax-offline", "nbclient": "nbclient",
+              "nbformat": "nbformat", "ipykernel": "ipykernel"}
 REPO_ROOT = Path(__file__).resolve().parents[1]
 
 # An erratum paragraph starts with a bold lead such as "**Erratum (1.1).**" or
@@ -70,7 +71,7 @@ div.admonition.erratum > .admonition-title {
 div.admonition.erratum > .admonition-title::after { color: #c2410c; }
 html[data-theme="dark"] div.admonition.erratum { background: #3b2314; }
 html[data-theme="dark"] div.admonition.erratum > .admonition-title { background: #5a2e12; color: #ffedd5; }
-details.solution, .cell details.hide, section details {
+section details {
   margin: 0.5em 0 1em 0;
 }
 /* the book theme keeps the sidebar toggle and the search in its own bars; newer releases of the
@@ -328,6 +329,7 @@ exclude_patterns = ["_build", "**.ipynb_checkpoints"]
 master_doc = "index"
 nb_execution_mode = "off"           # the notebooks arrive executed
 nb_merge_streams = True
+nb_render_markdown_format = "myst"  # markdown outputs (the exercise data) with $...$ math
 myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence"]
 myst_dmath_double_inline = True
 myst_heading_anchors = 3
@@ -371,8 +373,7 @@ def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: i
         raise ValueError(f"timeout must be a positive whole number of seconds, got {timeout!r}")
     out = Path(out_dir).resolve()
     sources = chapter_notebooks(REPO_ROOT / "notebooks" if notebooks_dir is None else notebooks_dir)
-    if out in [p.parent.resolve() for p in sources]:
-        raise ValueError(f"out_dir {str(out_dir)!r} is the notebooks folder; pick an empty or new folder")
+    _check_out_dir(out, sources)
     missing = missing_site_tools()
     if missing:
         raise RuntimeError("the site tools are not installed (" + ", ".join(missing) + "): run "
@@ -389,6 +390,18 @@ def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: i
             shutil.rmtree(out)
         shutil.copytree(html, out)
     return out / "index.html"
+
+
+def _check_out_dir(out: Path, sources: list[Path]) -> None:
+    """Refuse an output folder whose replacement would delete anything but an earlier site."""
+    if out in [p.parent.resolve() for p in sources]:
+        raise ValueError(f"out_dir {str(out)!r} is the notebooks folder; pick an empty or new folder")
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"out_dir {str(out)!r} is a file; pick an empty or new folder")
+    earlier_site = (out / "index.html").is_file() and (out / "_static").is_dir()
+    if out.is_dir() and any(out.iterdir()) and not earlier_site:
+        raise ValueError(f"out_dir {str(out)!r} holds files that are not a site built before "
+                         "(they would be deleted); pick an empty or new folder")
 
 
 def _say(verbose: bool, message: str) -> None:

@@ -182,6 +182,15 @@ def test_build_site_refuses_to_write_over_the_notebooks(tmp_path):
         site.build_site(tmp_path, notebooks_dir=tmp_path)
 
 
+def test_build_site_never_deletes_a_folder_that_is_not_a_site(tmp_path):
+    (tmp_path / "notes.txt").write_text("keep me")
+    with pytest.raises(ValueError, match="not a site built before"):
+        site.build_site(tmp_path, notebooks_dir=NOTEBOOKS)
+    with pytest.raises(ValueError, match="is a file"):
+        site.build_site(tmp_path / "notes.txt", notebooks_dir=NOTEBOOKS)
+    assert (tmp_path / "notes.txt").read_text() == "keep me"
+
+
 def test_command_line_needs_out_and_reports_errors(tmp_path, capsys):
     with pytest.raises(SystemExit) as stop:
         main(["site"])
@@ -206,6 +215,7 @@ SMALL_NOTEBOOK = [
           "         'application/vnd.jupyter.' + 'widget-view+json':\n"
           "             {'model_id': 'm1', 'version_major': 2, 'version_minor': 0}}, raw=True)"),
     _markdown("### Exercise 7.1: one number"),
+    _code("display({'text/markdown': '`n` $= 42$'}, raw=True)   # exercise data are typeset this way"),
     _code("answer = None"),
     _code("answer = 6 * 7  # worked solution: SOLUTION-IN-CODE", tags=["solution"]),
     _markdown("<details><summary>Solution</summary>\n\n```python\nanswer = 42  # SOLUTION-IN-MARKDOWN\n```\n\n"
@@ -241,6 +251,7 @@ def test_small_build_instructor_site(tmp_path):
     assert re.search(r'<script[^>]*src="_static/mathjax/tex-chtml\.js"', page)
     assert not re.search(r'<(script|link)[^>]*(src|href)="(https?:)?//', page)
     assert '<span class="math' in page
+    assert '<span class="math notranslate nohighlight">\\(= 42\\)</span>' in page   # math in markdown output
     # the explorer: its static figure, no widget view
     assert re.search(r'<img[^>]*src="_images/', page) and site.WIDGET_VIEW not in page
     # the erratum box

@@ -246,12 +246,14 @@ def _check_chapter(v, name: str, report: dict) -> None:
     text = _markdown(nb)
     assert report["math"] > 20, "a chapter page without equations: math is not parsed"
     # section numbers: exactly the notebook's headings, no second numbering added
-    source_headings = [re.sub(r"[`*]", "", h) for h in re.findall(r"^#{1,4} (.+?)\s*$", text, re.MULTILINE)]
+    prose = re.sub(r"```.*?```", "", text, flags=re.DOTALL)    # a "# comment" in code is no heading
+    source_headings = re.findall(r"^#{1,4} (.+?)\s*$", prose, re.MULTILINE)
     page_headings = [re.sub(r"\s+", " ", h) for h in report["headings"]]
-    number = name.split("_")[0].lstrip("0")
-    numbered = [h for h in page_headings if re.match(r"\d", h)]
-    assert numbered and all(re.match(rf"{number}\.\d", h) for h in numbered), numbered
     assert len(page_headings) == len(source_headings), (page_headings, source_headings)
+    numbers = [re.match(r"[\d.–]*", h).group() for h in page_headings]
+    assert numbers == [re.match(r"[\d.–]*", h).group() for h in source_headings]
+    chapter = name.split("_")[0].lstrip("0")
+    assert all(n.startswith(f"{chapter}.") for n in numbers if n), numbers
     # explorers: every one shows its figure
     explorers = v.page.evaluate(EXPLORER_REPORT)
     calls = sum(bool(_EXPLORER_CALL.search(c.source)) for c in nb.cells if c.cell_type == "code")
