@@ -276,7 +276,7 @@ def landing_page(chapters: list[dict], *, student: bool = False, run_online: str
     """The MyST text of the landing page: the chapter table and how to run the notebooks."""
     edition = ("This is the **student edition**: the exercises are there, their solutions are not."
                if student else
-               "Each exercise ends with its worked solution, folded: click *Show solution*.")
+               "Each exercise is followed by its worked solution, folded: click the line above it to open it.")
     rows = [f"| {c['number']} | [{c['title']}]({c['page']}.ipynb) | {' · '.join(c['sections'])} |"
             for c in chapters]
     online = f"\n### Run online\n\n{run_online.strip()}\n" if run_online.strip() else ""

@@ -151,7 +151,7 @@ def test_landing_page_has_a_row_and_a_toctree_entry_per_chapter():
     assert "| 2 | [Two](02_two.ipynb) |  |" in text
     assert re.search(r"```\{toctree\}\n:hidden:\n:maxdepth: 2\n\n01_one\n02_two\n```", text)
     assert 'python -m pip install -e ".[lab]"' in text and "python -m jupyterlab notebooks/" in text
-    assert "### Run online" in text and "Show solution" in text
+    assert "### Run online" in text and "worked solution, folded" in text
     student = site.landing_page(chapters, student=True)
     assert "student edition" in student and "Run online" not in student
 
