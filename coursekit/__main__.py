@@ -103,8 +103,34 @@ def _run_colab(args) -> int:
     return 0
 
 
+def _add_site(commands) -> None:
+    parser = commands.add_parser(
+        "site", help="build the course website (static, works offline)",
+        description="Execute the chapter notebooks and build a static website of the course into "
+                    "DIR: chapter navigation, equations typeset, every figure, explorers as "
+                    "their static figures, erratum boxes, solutions folded. Needs the site "
+                    "extra: python -m pip install -e \".[site]\". View it with "
+                    "python -m http.server -d DIR (or open DIR/index.html).")
+    parser.add_argument("--out", required=True, type=Path, metavar="DIR",
+                        help="folder to write the site into (an earlier site there is replaced)")
+    parser.add_argument("--student", action="store_true",
+                        help="build from the student edition: exercises without their solutions")
+    parser.add_argument("--notebooks", type=Path, default=None, metavar="DIR",
+                        help="folder of the chapter notebooks (default: the repository's notebooks/)")
+    parser.set_defaults(run=_run_site)
+
+
+def _run_site(args) -> int:
+    from .site import build_site
+    index = build_site(args.out, student=args.student, notebooks_dir=args.notebooks, verbose=True)
+    print(f"site written to {index.parent}\n"
+          f"view it: python -m http.server -b 127.0.0.1 -d {index.parent}  (then open "
+          "http://127.0.0.1:8000), or open index.html in a browser")
+    return 0
+
+
 #: one function per command, in the order of --help
-COMMANDS = (_add_release, _add_slides, _add_colab)
+COMMANDS = (_add_release, _add_slides, _add_colab, _add_site)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -125,7 +151,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     try:
         return args.run(args)
-    except (ValueError, OSError) as error:
+    except (ValueError, TypeError, RuntimeError, OSError) as error:
         parser.exit(2, f"{parser.prog} {args.command}: error: {error}\n")
 
 

@@ -1,0 +1,260 @@
+"""The course website's pieces (coursekit.site) and one small build without a browser.
+
+The full build of the four chapters, checked page by page in Chromium, is in
+tests/test_site_browser.py (marker ``browser``). Here: the markdown and notebook rewrites, the
+landing page, argument checks, the command line, and a build of one small notebook that holds one
+of each thing the site treats specially (skipped, with the reason, without the ``site`` extra).
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import re
+from pathlib import Path
+
+import nbformat
+import pytest
+
+from coursekit import site
+from coursekit.__main__ import main
+
+NOTEBOOKS = Path(__file__).parents[1] / "notebooks"
+
+
+def _code(source, tags=(), outputs=()):
+    cell = nbformat.v4.new_code_cell(source)
+    if tags:
+        cell.metadata["tags"] = list(tags)
+    cell.outputs = list(outputs)
+    return cell
+
+
+def _markdown(source, tags=()):
+    cell = nbformat.v4.new_markdown_cell(source)
+    if tags:
+        cell.metadata["tags"] = list(tags)
+    return cell
+
+
+# --- errata ------------------------------------------------------------------------------
+
+def test_blockquote_with_two_errata_becomes_two_boxes():
+    text = ("Intro $x$.\n\n> **Erratum (1.1).** First slip,\n> second line.\n>\n"
+            "> **Erratum (1.2).** Second slip.\n\nAfter.")
+    out = site.erratum_admonitions(text)
+    assert out.count("::::{admonition} ") == 2
+    assert "::::{admonition} Erratum (1.1)\n:class: erratum\nFirst slip,\nsecond line.\n::::" in out
+    assert "::::{admonition} Erratum (1.2)\n:class: erratum\nSecond slip.\n::::" in out
+    assert out.startswith("Intro $x$.\n") and out.endswith("After.")
+    assert "**Erratum" not in out and "> " not in out
+
+
+def test_remark_erratum_and_following_quote_paragraph_stay_in_one_box():
+    text = "> **Remark / erratum (1.9).** The printed version.\n>\n> $$\\dot x = f(x)$$\n\nNext."
+    out = site.erratum_admonitions(text)
+    assert out.count("::::{admonition} Remark / erratum (1.9)") == 1
+    box = out[out.index("::::{admonition}"):out.rindex("::::")]
+    assert "$$\\dot x = f(x)$$" in box
+    assert out.endswith("Next.")
+
+
+def test_plain_paragraph_erratum_keeps_the_equation_it_announces():
+    text = ("Before.\n\n**Erratum (2.15).** False; solving gives:\n\n$$A^2B = -2AB + B.$$\n\n"
+            "(The conclusion stands.)")
+    out = site.erratum_admonitions(text)
+    box = out[out.index("::::{admonition} Erratum (2.15)"):]
+    box = box[:box.index("\n::::") + 5]
+    assert "$$A^2B = -2AB + B.$$" in box
+    assert "(The conclusion stands.)" not in box
+    assert out.endswith("(The conclusion stands.)")
+
+
+def test_text_without_errata_and_code_fences_are_left_alone():
+    text = ("# Title\n\n> A quote, not an erratum.\n\nSome **bold** text.\n\n```python\n"
+            "**Erratum (9.9).** inside code\n\n**Erratum (9.8).** still code\n```\n")
+    assert site.erratum_admonitions(text) == text
+
+
+def test_erratum_admonitions_refuses_non_text():
+    with pytest.raises(TypeError, match="markdown must be a str"):
+        site.erratum_admonitions(["> **Erratum"])
+
+
+# --- notebook rewrites ---------------------------------------------------------------------
+
+def _widget_output(with_png=True):
+    data = {site.WIDGET_VIEW: {"model_id": "abc", "version_major": 2, "version_minor": 0},
+            "text/plain": "Explorer"}
+    if with_png:
+        data["image/png"] = "iVBORw0KGgo="
+    return nbformat.v4.new_output("display_data", data=data)
+
+
+def test_strip_widget_views_keeps_the_static_figure():
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["widgets"] = {"application/vnd.jupyter.widget-state+json": {}}
+    nb.cells = [_code("explorer()", outputs=[_widget_output()]),
+                _code("w", outputs=[nbformat.v4.new_output("display_data", data={site.WIDGET_VIEW: {}})]),
+                _markdown("text")]
+    site.strip_widget_views(nb)
+    assert set(nb.cells[0].outputs[0]["data"]) == {"image/png", "text/plain"}
+    assert nb.cells[1].outputs == []
+    assert "widgets" not in nb.metadata
+
+
+def test_fold_solution_code_folds_only_solution_code_cells():
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [_code("x = None"), _code("x = 42", tags=["solution"]),
+                _markdown("<details>...</details>", tags=["solution"])]
+    site.fold_solution_code(nb)
+    assert "tags" not in nb.cells[0].metadata
+    assert nb.cells[1].metadata["tags"] == ["solution", "hide-cell"]
+    assert nb.cells[1].metadata["mystnb"]["code_prompt_show"] == "Show solution"
+    assert nb.cells[2].metadata["tags"] == ["solution"]
+
+
+# --- landing page and notebooks ------------------------------------------------------------
+
+def test_chapter_entry_reads_title_and_numbered_sections_of_chapter_1():
+    nb = nbformat.read(NOTEBOOKS / "01_representations.ipynb", as_version=4)
+    entry = site.chapter_entry(nb, "01_representations")
+    assert entry["number"] == "1"
+    assert entry["title"] == "Signals, systems and their representations"
+    assert entry["sections"][:2] == ["1.1 Introduction", "1.2 A few systems"]
+    assert all(s.startswith("1.") for s in entry["sections"])
+
+
+def test_chapter_entry_needs_a_title():
+    nb = nbformat.v4.new_notebook()
+    nb.cells = [_markdown("no title here")]
+    with pytest.raises(ValueError, match="no '# ' title"):
+        site.chapter_entry(nb, "05_x")
+
+
+def test_landing_page_has_a_row_and_a_toctree_entry_per_chapter():
+    chapters = [{"number": "1", "title": "One", "page": "01_one", "sections": ["1.1 A", "1.2 B"]},
+                {"number": "2", "title": "Two", "page": "02_two", "sections": []}]
+    text = site.landing_page(chapters, run_online="Open the [course online](https://example.org).")
+    assert "| 1 | [One](01_one.ipynb) | 1.1 A · 1.2 B |" in text
+    assert "| 2 | [Two](02_two.ipynb) |  |" in text
+    assert re.search(r"```\{toctree\}\n:hidden:\n:maxdepth: 2\n\n01_one\n02_two\n```", text)
+    assert 'python -m pip install -e ".[lab]"' in text and "python -m jupyterlab notebooks/" in text
+    assert "### Run online" in text and "worked solution, folded" in text
+    student = site.landing_page(chapters, student=True)
+    assert "student edition" in student and "Run online" not in student
+
+
+def test_chapter_notebooks_are_found_in_order_and_bad_folders_refused(tmp_path):
+    assert [p.name for p in site.chapter_notebooks(NOTEBOOKS)][:2] == [
+        "01_representations.ipynb", "02_controllability.ipynb"]
+    with pytest.raises(ValueError, match="not a directory"):
+        site.chapter_notebooks(tmp_path / "missing")
+    with pytest.raises(ValueError, match="no chapter notebook"):
+        site.chapter_notebooks(tmp_path)
+
+
+@pytest.mark.parametrize("kwargs, error, match", [
+    ({"student": "yes"}, TypeError, "student must be True or False"),
+    ({"verbose": 1}, TypeError, "verbose must be True or False"),
+    ({"timeout": 0}, ValueError, "timeout must be a positive"),
+    ({"timeout": 2.5}, ValueError, "timeout must be a positive"),
+])
+def test_build_site_checks_its_arguments(tmp_path, kwargs, error, match):
+    with pytest.raises(error, match=match):
+        site.build_site(tmp_path / "out", **kwargs)
+
+
+def test_build_site_refuses_to_write_over_the_notebooks(tmp_path):
+    nbformat.write(nbformat.v4.new_notebook(), tmp_path / "01_a.ipynb")
+    with pytest.raises(ValueError, match="is the notebooks folder"):
+        site.build_site(tmp_path, notebooks_dir=tmp_path)
+
+
+def test_build_site_never_deletes_a_folder_that_is_not_a_site(tmp_path):
+    (tmp_path / "notes.txt").write_text("keep me")
+    with pytest.raises(ValueError, match="not a site built before"):
+        site.build_site(tmp_path, notebooks_dir=NOTEBOOKS)
+    with pytest.raises(ValueError, match="is a file"):
+        site.build_site(tmp_path / "notes.txt", notebooks_dir=NOTEBOOKS)
+    assert (tmp_path / "notes.txt").read_text() == "keep me"
+
+
+def test_command_line_needs_out_and_reports_errors(tmp_path, capsys):
+    with pytest.raises(SystemExit) as stop:
+        main(["site"])
+    assert stop.value.code == 2
+    assert "--out" in capsys.readouterr().err
+    assert main(["site", "--out", str(tmp_path / "o"), "--notebooks", str(tmp_path / "none")]) == 1
+    assert "not a directory" in capsys.readouterr().err
+
+
+# --- one small build --------------------------------------------------------------------------
+
+PNG = base64.b64encode(bytes.fromhex(
+    "89504e470d0a1a0a0000000d4948445200000001000000010806000000"
+    "1f15c4890000000d49444154789c6360f8cfc0f01f0005000201a5b7e1"
+    "d60000000049454e44ae426082")).decode()
+
+SMALL_NOTEBOOK = [
+    _markdown("# Chapter 7 — A small chapter\n\nIntro with $\\dot x = A x$."),
+    _markdown("## 7.1 First section\n\n> **Erratum (7.1).** The notes print $A^T$; it is $A$."),
+    _code("from IPython.display import display\n"
+          f"display({{'image/png': '{PNG}', 'text/plain': 'explorer (static figure)',\n"
+          "         'application/vnd.jupyter.' + 'widget-view+json':\n"
+          "             {'model_id': 'm1', 'version_major': 2, 'version_minor': 0}}, raw=True)"),
+    _markdown("### Exercise 7.1: one number"),
+    _code("display({'text/markdown': '`n` $= 42$'}, raw=True)   # exercise data are typeset this way"),
+    _code("answer = None"),
+    _code("answer = 6 * 7  # worked solution: SOLUTION-IN-CODE", tags=["solution"]),
+    _markdown("<details><summary>Solution</summary>\n\n```python\nanswer = 42  # SOLUTION-IN-MARKDOWN\n```\n\n"
+              "</details>", tags=["solution"]),
+]
+
+
+def _small_build(tmp_path, student):
+    missing = site.missing_site_tools()
+    if missing:
+        pytest.skip("the site extra is not installed (missing: " + ", ".join(missing) + ")")
+    folder = tmp_path / "nb"
+    folder.mkdir(exist_ok=True)
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nb.cells = SMALL_NOTEBOOK
+    nbformat.write(nb, folder / "07_small.ipynb")
+    index = site.build_site(tmp_path / ("student" if student else "site"), student=student,
+                            notebooks_dir=folder, readme=tmp_path / "no-readme.md")
+    return index, (index.parent / "07_small.html").read_text(encoding="utf-8")
+
+
+def _text(page: str) -> str:
+    return html.unescape(re.sub(r"<[^>]+>", "", page))
+
+
+def test_small_build_instructor_site(tmp_path):
+    index, page = _small_build(tmp_path, student=False)
+    out = index.parent
+    assert "07_small.html" in index.read_text(encoding="utf-8")
+    # math: typeset by the MathJax copied into the site, loaded from there
+    assert (out / "_static" / "mathjax" / "tex-chtml.js").is_file()
+    assert re.search(r'<script[^>]*src="_static/mathjax/tex-chtml\.js"', page)
+    assert not re.search(r'<(script|link)[^>]*(src|href)="(https?:)?//', page)
+    assert '<span class="math' in page
+    assert '<span class="math notranslate nohighlight">\\(= 42\\)</span>' in page   # math in markdown output
+    # the explorer: its static figure, no widget view
+    assert re.search(r'<img[^>]*src="_images/', page) and site.WIDGET_VIEW not in page
+    # the erratum box
+    assert '<div class="erratum admonition">' in page and "**Erratum" not in page
+    # both kinds of solution, folded
+    assert "SOLUTION-IN-CODE" in _text(page) and "SOLUTION-IN-MARKDOWN" in _text(page)
+    assert "Show solution" in page and page.count("<details") >= 2
+    assert not re.search(r"<details[^>]*\sopen", page)
+    # section numbers are the notebook's own: no second numbering added
+    assert re.search(r"<h2>7\.1 First section", page)
+
+
+def test_small_build_student_site_has_no_solutions(tmp_path):
+    index, page = _small_build(tmp_path, student=True)
+    assert "student edition" in index.read_text(encoding="utf-8")
+    assert "answer = None" in _text(page)
+    assert "SOLUTION" not in _text(page) and "Show solution" not in page

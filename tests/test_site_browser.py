@@ -1,0 +1,314 @@
+"""The course website in a real browser: both editions built, served on loopback, every page opened.
+
+Builds the site twice (``build_site`` for the instructor, ``student=True`` for the student
+edition; one build each for the whole module), serves the two folders with ``http.server`` on a
+free 127.0.0.1 port and opens every HTML page in headless Chromium (Playwright, the system
+Chromium, no browser download). A page fails on: a console error or an uncaught exception, a
+request to any host but 127.0.0.1 (each is recorded and aborted, so the site must work with no
+network), a broken image, an equation MathJax did not typeset (or TeX left in the text), an
+explorer without its figure or with a widget area, a missing or unstyled erratum box, section
+numbers other than the notebook's own, a solution that is not folded (instructor) or that is
+present at all (student). Skipped, with the reason, without Playwright, Chromium or the site extra.
+"""
+
+from __future__ import annotations
+
+import html
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+import nbformat
+import pytest
+
+from coursekit import site
+
+pytestmark = pytest.mark.browser
+
+NOTEBOOKS = Path(__file__).parents[1] / "notebooks"
+CHAPTERS = [p.stem for p in site.chapter_notebooks(NOTEBOOKS)]
+PAGES = ["index", *CHAPTERS, "genindex", "search"]
+EDITIONS = ["instructor", "student"]
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync", "--no-first-run"]
+ERRATUM_BACKGROUND = "rgb(255, 247, 237)"   # coursekit.site.CSS, light mode
+_ERRATUM_SOURCE = re.compile(r"\*\*(?:Erratum|Remark\s*/\s*erratum)\b", re.IGNORECASE)
+_EXPLORER_CALL = re.compile(r"\b\w+_explorer\(")
+
+
+def _chromium() -> str | None:
+    for candidate in ("/usr/bin/chromium", shutil.which("chromium"), shutil.which("chromium-browser")):
+        if candidate and os.access(candidate, os.X_OK):
+            return candidate
+    return None
+
+
+def _skip_reason() -> str | None:
+    try:
+        import playwright.sync_api  # noqa: F401
+    except ImportError:
+        return "Playwright for Python is not installed (python -m pip install playwright)"
+    if _chromium() is None:
+        return "Chromium is not installed (Debian/Ubuntu: apt-get install -y chromium)"
+    missing = site.missing_site_tools()
+    if missing:
+        return "the site extra is not installed (python -m pip install -e \".[site]\"; missing: " \
+               + ", ".join(missing) + ")"
+    return None
+
+
+@pytest.fixture(scope="module")
+def built(tmp_path_factory):
+    """Both editions, built once for the module: {edition: folder}."""
+    reason = _skip_reason()
+    if reason:
+        pytest.skip(reason)
+    base = tmp_path_factory.mktemp("site")
+    folders = {}
+    for edition in EDITIONS:
+        start = time.monotonic()
+        site.build_site(base / edition, student=edition == "student")
+        print(f"\n{edition} site built in {time.monotonic() - start:.0f} s")
+        folders[edition] = base / edition
+    return folders
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+@pytest.fixture(scope="module")
+def server(built):
+    """http.server on a free loopback port serving both editions: its base URL."""
+    root = next(iter(built.values())).parent
+    port = _free_port()
+    proc = subprocess.Popen([sys.executable, "-m", "http.server", "--bind", "127.0.0.1",
+                             "--directory", str(root), str(port)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    url = f"http://127.0.0.1:{port}"
+    try:
+        deadline = time.monotonic() + 30
+        while True:
+            try:
+                urllib.request.urlopen(f"{url}/instructor/index.html", timeout=2).close()
+                break
+            except OSError:
+                if proc.poll() is not None or time.monotonic() > deadline:
+                    pytest.fail(f"http.server did not answer on {url} (exit code {proc.poll()})")
+                time.sleep(0.2)
+        yield url
+    finally:
+        proc.terminate()
+        proc.wait(timeout=10)
+
+
+@pytest.fixture(scope="module")
+def browser(built):
+    from playwright.sync_api import sync_playwright
+    with sync_playwright() as pw:
+        chromium = pw.chromium.launch(executable_path=_chromium(), args=CHROMIUM_ARGS, headless=True)
+        yield chromium
+        chromium.close()
+
+
+class Visit:
+    """One page opened with every outside request refused and every error recorded."""
+
+    def __init__(self, browser, url: str):
+        self.context = browser.new_context(viewport={"width": 1300, "height": 900})
+        self.outside, self.errors = [], []
+        self.context.route("**/*", self._route)
+        self.page = self.context.new_page()
+        self.page.on("console", lambda m: self.errors.append(m.text) if m.type == "error" else None)
+        self.page.on("pageerror", lambda e: self.errors.append(f"uncaught: {e}"))
+        self.page.goto(url, wait_until="load")
+        if self.page.query_selector("script[src*='mathjax']") is not None:
+            self.page.wait_for_function("window.MathJax && MathJax.startup && MathJax.startup.promise",
+                                        timeout=60_000)
+            self.page.evaluate("MathJax.startup.promise.then(() => true)")
+
+    def _route(self, route):
+        url = route.request.url
+        if re.match(r"^(https?|wss?)://127\.0\.0\.1(:\d+)?/", url) or url.startswith(("file:", "data:")):
+            route.continue_()
+        else:
+            self.outside.append(url)
+            route.abort()
+
+    def close(self):
+        self.context.close()
+
+
+@pytest.fixture
+def visit(browser):
+    opened = []
+
+    def open_page(url):
+        opened.append(Visit(browser, url))
+        return opened[-1]
+
+    yield open_page
+    for v in opened:
+        v.close()
+
+
+PAGE_REPORT = """() => {
+  const article = document.querySelector('article') || document.body;
+  const broken = [...document.images].filter(i => !(i.complete && i.naturalWidth > 0))
+                                      .map(i => i.getAttribute('src'));
+  const math = [...document.querySelectorAll('.math')];
+  const untypeset = math.filter(m => !m.querySelector('mjx-container')).map(m => m.textContent.slice(0, 80));
+  const rawTex = [];
+  const walker = document.createTreeWalker(article, NodeFilter.SHOW_TEXT);
+  for (let n = walker.nextNode(); n; n = walker.nextNode()) {
+    if (n.parentElement.closest('pre, code, script, style, mjx-container')) continue;
+    if (/\\$[^$\\s][^$]*\\$|\\\\\\(|\\\\\\[|\\\\begin\\{|\\*\\*Erratum/i.test(n.textContent)) rawTex.push(n.textContent.slice(0, 80));
+  }
+  const widgets = document.querySelectorAll(
+    'script[type*="widget"], .jupyter-widgets, .widget-area, .jp-OutputArea-output:empty').length;
+  const headings = [...article.querySelectorAll('h1, h2, h3, h4')]
+                     .map(h => h.textContent.replace(/#$/, '').trim());
+  const searchFields = [...document.querySelectorAll('.search-button-field')].filter(e => e.checkVisibility()).length;
+  return {broken, untypeset, rawTex, widgets, headings, searchFields, math: math.length};
+}"""
+
+EXPLORER_REPORT = """() => [...document.querySelectorAll('.cell')]
+  .filter(c => /\\b\\w+_explorer\\(/.test((c.querySelector('.cell_input') || {}).textContent || ''))
+  .map(c => [...c.querySelectorAll('.cell_output img')].filter(i => i.naturalWidth >= 200).length)"""
+
+ERRATUM_REPORT = """() => [...document.querySelectorAll('div.erratum.admonition')].map(box => ({
+  title: box.querySelector('.admonition-title').textContent.trim(),
+  background: getComputedStyle(box).backgroundColor,
+  height: box.getBoundingClientRect().height}))"""
+
+
+def _notebook(name: str):
+    return nbformat.read(NOTEBOOKS / f"{name}.ipynb", as_version=4)
+
+
+def _markdown(nb) -> str:
+    return "\n\n".join(c.source for c in nb.cells if c.cell_type == "markdown")
+
+
+def _count_errata(markdown: str) -> int:
+    """Paragraphs (in a blockquote or not) that start with a bold "Erratum" lead."""
+    unquoted = re.sub(r"^> ?", "", markdown, flags=re.MULTILINE)
+    paragraphs = re.split(r"\n\s*\n", unquoted)
+    return sum(bool(_ERRATUM_SOURCE.match(p.strip())) for p in paragraphs)
+
+
+def _solution_lines(nb) -> list[str]:
+    """One distinctive line of each solution cell: its longest line of code."""
+    lines = []
+    for cell in nb.cells:
+        if "solution" not in cell.metadata.get("tags", []):
+            continue
+        code = cell.source
+        if cell.cell_type == "markdown":
+            code = "\n".join(re.findall(r"```[a-z]*\n(.*?)```", code, re.DOTALL))
+        candidates = [line.strip() for line in code.splitlines() if len(line.strip()) >= 15]
+        assert candidates, f"a solution cell without a line of code to look for: {cell.source[:80]!r}"
+        lines.append(max(candidates, key=len))
+    return lines
+
+
+def test_every_page_and_only_those_are_built(built):
+    for edition, folder in built.items():
+        assert sorted(p.stem for p in folder.glob("*.html")) == sorted(PAGES), edition
+
+
+@pytest.mark.parametrize("edition", EDITIONS)
+@pytest.mark.parametrize("name", PAGES)
+def test_page_loads_offline_with_images_and_typeset_math(name, edition, server, visit):
+    v = visit(f"{server}/{edition}/{name}.html")
+    report = v.page.evaluate(PAGE_REPORT)
+    assert v.outside == [], f"requests to hosts other than 127.0.0.1: {v.outside}"
+    assert v.errors == [], f"console errors: {v.errors}"
+    assert report["broken"] == [], f"broken images: {report['broken']}"
+    assert report["untypeset"] == [], f"equations not typeset: {report['untypeset'][:5]}"
+    assert report["rawTex"] == [], f"TeX or markdown left in the text: {report['rawTex'][:5]}"
+    assert report["widgets"] == 0, "an empty widget area is on the page"
+    assert report["searchFields"] <= 1, "the search field is shown twice (a second top bar)"
+    if name in CHAPTERS:
+        _check_chapter(v, name, report)
+
+
+def _check_chapter(v, name: str, report: dict) -> None:
+    nb = _notebook(name)
+    text = _markdown(nb)
+    assert report["math"] > 20, "a chapter page without equations: math is not parsed"
+    # section numbers: exactly the notebook's headings, no second numbering added
+    prose = re.sub(r"```.*?```", "", text, flags=re.DOTALL)    # a "# comment" in code is no heading
+    source_headings = re.findall(r"^#{1,4} (.+?)\s*$", prose, re.MULTILINE)
+    page_headings = [re.sub(r"\s+", " ", h) for h in report["headings"]]
+    assert len(page_headings) == len(source_headings), (page_headings, source_headings)
+    numbers = [re.match(r"[\d.–]*", h).group() for h in page_headings]
+    assert numbers == [re.match(r"[\d.–]*", h).group() for h in source_headings]
+    chapter = name.split("_")[0].lstrip("0")
+    assert all(n.startswith(f"{chapter}.") for n in numbers if n), numbers
+    # explorers: every one shows its figure
+    explorers = v.page.evaluate(EXPLORER_REPORT)
+    calls = sum(bool(_EXPLORER_CALL.search(c.source)) for c in nb.cells if c.cell_type == "code")
+    assert len(explorers) == calls > 0
+    assert all(count >= 1 for count in explorers), f"explorers without a figure: {explorers}"
+    # errata: one styled box per erratum of the notebook
+    boxes = v.page.evaluate(ERRATUM_REPORT)
+    assert len(boxes) == _count_errata(text) > 0
+    for box in boxes:
+        assert re.match(r"(Remark / )?[Ee]rratum", box["title"]) and box["height"] > 30, box
+        assert box["background"] == ERRATUM_BACKGROUND, box
+
+
+@pytest.mark.parametrize("name", CHAPTERS)
+def test_instructor_solutions_are_folded_and_open_with_a_click(name, server, visit):
+    lines = _solution_lines(_notebook(name))
+    assert lines, f"{name} has no solution cell"
+    v = visit(f"{server}/instructor/{name}.html")
+    hidden = v.page.evaluate("""(lines) => lines.map(line => {
+        const pre = [...document.querySelectorAll('pre')].find(p => p.textContent.includes(line));
+        return pre ? (pre.closest('details') !== null && pre.checkVisibility() === false) : null;
+      })""", lines)
+    assert hidden == [True] * len(lines), f"solutions missing (null) or not folded (false): {hidden}"
+    summary = v.page.locator("details:has(pre) > summary").first
+    summary.click()
+    assert v.page.locator("details[open] pre").first.is_visible()
+
+
+def _page_text(path: Path) -> str:
+    return html.unescape(re.sub(r"<[^>]+>", "", path.read_text(encoding="utf-8")))
+
+
+@pytest.mark.parametrize("name", CHAPTERS)
+def test_student_site_has_no_solution(name, built):
+    lines = _solution_lines(_notebook(name))
+    instructor = _page_text(built["instructor"] / f"{name}.html")
+    student = _page_text(built["student"] / f"{name}.html")
+    assert [line for line in lines if line not in instructor] == []
+    assert [line for line in lines if line in student] == []
+    assert "Show solution" not in student and "Exercise" in student
+
+
+@pytest.mark.parametrize("edition", EDITIONS)
+def test_landing_page_links_every_chapter(edition, server, visit):
+    v = visit(f"{server}/{edition}/index.html")
+    links = v.page.eval_on_selector_all("article table a", "as => as.map(a => a.getAttribute('href'))")
+    assert links == [f"{name}.html" for name in CHAPTERS]
+    body = v.page.inner_text("article")
+    assert 'pip install -e ".[lab]"' in body and "jupyterlab notebooks/" in body
+    assert ("student edition" in body) == (edition == "student")
+
+
+def test_site_works_opened_as_a_file(built, visit):
+    """index.html opened straight from the disk (no server) typesets its math too."""
+    v = visit((built["instructor"] / f"{CHAPTERS[0]}.html").as_uri())
+    report = v.page.evaluate(PAGE_REPORT)
+    assert v.outside == [] and v.errors == []
+    assert report["math"] > 20 and report["untypeset"] == [] and report["broken"] == []
