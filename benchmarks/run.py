@@ -265,7 +265,7 @@ def bench_browser(steps: int, shots: Path | None = None) -> list[str]:
     kernel_ms = {}
     for label, factory in factories.items():
         explorer = factory()
-        kernel_ms[label] = 1e3 * interleaved({"refresh": explorer.refresh}, 7)["refresh"]
+        kernel_ms[label] = 1e3 * interleaved({"refresh": explorer.refresh}, 11)["refresh"]
     return browser.run_browser(list(factories), kernel_ms, steps=steps, shots=shots,
                                log=lambda line: print(line, file=sys.stderr))
 

@@ -24,6 +24,7 @@ Skipped with the reason when either is missing. Run only these tests with
 from __future__ import annotations
 
 import base64
+import contextlib
 import io
 import json
 import shutil
@@ -118,17 +119,21 @@ def page(lab):
 
 @pytest.fixture
 def opened(lab, page, tmp_path):
-    """Opens a notebook with `opened(name)`; on failure leaves a screenshot; closes everything."""
-    try:
-        yield lambda name: lab_h.open_notebook(page, name)
-    except BaseException:
-        shot = tmp_path / "failing-page.png"
-        page.screenshot(path=str(shot), full_page=True)
-        print(f"screenshot of the failing page: {shot}")
-        raise
-    finally:
-        lab_h.close_all(page)
-        lab_h.shut_down_kernels(lab)
+    """Opens a notebook with `opened(name)`; on a failure of the test leaves a screenshot of
+    the page (its path is printed); at the end closes every tab and stops the kernels."""
+    @contextlib.contextmanager
+    def open_and_watch(name):
+        try:
+            lab_h.open_notebook(page, name)
+            yield
+        except BaseException:
+            shot = tmp_path / f"{name}.png"
+            page.screenshot(path=str(shot), full_page=True)
+            print(f"screenshot of the failing page: {shot}")
+            raise
+    yield open_and_watch
+    lab_h.close_all(page)
+    lab_h.shut_down_kernels(lab)
 
 
 def _run_without_errors(page, name: str) -> list[str]:
@@ -143,37 +148,42 @@ def _run_without_errors(page, name: str) -> list[str]:
 @pytest.mark.parametrize("name", ["demo_explorer.ipynb", *_chapter_notebooks()])
 def test_notebook_runs_in_jupyterlab_and_its_explorer_answers(name, page, opened, capsys):
     t0 = time.monotonic()
-    opened(name)
-    t_open = time.monotonic() - t0
-    prompts = _run_without_errors(page, name)
-    t_run = time.monotonic() - t0 - t_open
-    assert len(prompts) == _count_code_cells(name), (
-        f"{name}: {len(prompts)} code cells rendered, the notebook has {_count_code_cells(name)}")
-    # from the notebook model, so cells whose input is collapsed count too
-    counts = page.evaluate("() => window.jupyterapp.shell.currentWidget.content.widgets"
-                           ".filter(c => c.model.type === 'code').map(c => c.model.executionCount)")
-    not_run = [i for i, count in enumerate(counts) if count is None]
-    assert not not_run, f"{name}: code cells {not_run} did not run (execution counts {counts})"
-    images = page.evaluate(_EXPLORER_IMAGES_JS)
-    assert images, f"{name}: no explorer figure (a widget with an image) was rendered"
-    t1 = time.monotonic()
-    _move_first_slider(page)
-    _wait_for_new_image(page, images[0], SLIDER_TIMEOUT_S)
-    t_slider = time.monotonic() - t1
-    errors = lab_h.error_outputs(page)
-    assert not errors, f"{name}: an error was reported after moving a slider:\n" + "\n----\n".join(errors)
-    with capsys.disabled():
-        print(f"\n[browser] {name}: open {t_open:.1f} s, run all {t_run:.1f} s "
-              f"({len(prompts)} code cells), slider -> new figure {t_slider:.1f} s")
+    with opened(name):
+        t_open = time.monotonic() - t0
+        prompts = _run_without_errors(page, name)
+        t_run = time.monotonic() - t0 - t_open
+        assert len(prompts) == _count_code_cells(name), (
+            f"{name}: {len(prompts)} code cells rendered, the notebook has {_count_code_cells(name)}")
+        # from the notebook model, so cells whose input is collapsed count too
+        counts = page.evaluate("() => window.jupyterapp.shell.currentWidget.content.widgets"
+                               ".filter(c => c.model.type === 'code').map(c => c.model.executionCount)")
+        not_run = [i for i, count in enumerate(counts) if count is None]
+        assert not not_run, f"{name}: code cells {not_run} did not run (execution counts {counts})"
+        images = page.evaluate(_EXPLORER_IMAGES_JS)
+        assert images, f"{name}: no explorer figure (a widget with an image) was rendered"
+        t1 = time.monotonic()
+        _move_first_slider(page)
+        _wait_for_new_image(page, images[0], SLIDER_TIMEOUT_S)
+        t_slider = time.monotonic() - t1
+        errors = lab_h.error_outputs(page)
+        assert not errors, f"{name}: an error was reported after moving a slider:\n" + "\n----\n".join(errors)
+        with capsys.disabled():
+            print(f"\n[browser] {name}: open {t_open:.1f} s, run all {t_run:.1f} s "
+                  f"({len(prompts)} code cells), slider -> new figure {t_slider:.1f} s")
 
 
 @pytest.mark.parametrize("name", list(DRAG_NOTEBOOKS))
 def test_explorer_follows_a_drag_and_ends_on_the_figure_of_the_final_value(name, page, opened):
-    cells, factory, shown = DRAG_NOTEBOOKS[name]
-    opened(name)
+    _, factory, shown = DRAG_NOTEBOOKS[name]
+    with opened(name):
+        _check_drag(page, name, factory, shown)
+
+
+def _check_drag(page, name: str, factory: str, shown: str) -> None:
+    """Drag the first slider; check the figure followed, ended right, and no error."""
     _run_without_errors(page, name)
     assert page.evaluate(_EXPLORER_IMAGES_JS), f"{name}: no explorer figure was rendered"
-    start_value = float(lab_h.first_slider(page).locator(".widget-readout").inner_text())
+    start_value = _readout_value(page)
     lab_h.install_probe(page)
     lab_h.drag(page, lab_h.first_slider(page), seconds=3.0, trips=1.5)
     state = lab_h.wait_until_quiet(page, quiet_ms=1000, timeout=SLIDER_TIMEOUT_S)
@@ -188,22 +198,30 @@ def test_explorer_follows_a_drag_and_ends_on_the_figure_of_the_final_value(name,
         f"{len(during)} time(s) before the mouse was released (at least 2 expected: the figure "
         "should follow the slider, not wait for the release)")
 
-    final_text = lab_h.first_slider(page).locator(".widget-readout").inner_text()
+    final_value = _readout_value(page)
     reference = json.loads(lab_h.execute_in_kernel(page, _REFERENCE_CODE.format(factory=factory, shown=shown)))
     kernel_value = list(reference["params"].values())[0]
-    assert float(final_text) != start_value, f"{name}: the drag ended where it started ({final_text})"
-    assert float(final_text) == pytest.approx(kernel_value, rel=1e-3, abs=1e-9), (
-        f"{name}: the slider shows {final_text}, the kernel has {kernel_value}")
+    assert final_value != start_value, f"{name}: the drag ended where it started ({final_value})"
+    assert final_value == pytest.approx(kernel_value, rel=1e-3, abs=1e-9), (
+        f"{name}: the slider shows {final_value}, the kernel has {kernel_value}")
     shown_png = base64.b64decode(page.evaluate(_SHOWN_PNG_JS))
     expected_png = base64.b64decode(reference["png"])
     shown_px, expected_px = _pixels(shown_png), _pixels(expected_png)
-    assert shown_px.shape == expected_px.shape and np.array_equal(shown_px, expected_px), (
+    assert shown_px.shape == expected_px.shape, (
+        f"{name}: the figure shown after the drag is {shown_px.shape[1::-1]} pixels, the one for "
+        f"the final parameters {reference['params']} is {expected_px.shape[1::-1]}")
+    differ = np.count_nonzero(np.any(shown_px != expected_px, axis=-1))
+    assert differ == 0, (
         f"{name}: the figure shown after the drag is not the one for the final parameters "
-        f"{reference['params']} (sizes {shown_px.shape} and {expected_px.shape}, "
-        f"{np.count_nonzero(np.any(shown_px != expected_px, axis=-1)) if shown_px.shape == expected_px.shape else 'all'}"
-        " pixels differ)")
+        f"{reference['params']} ({differ} pixels differ)")
     errors = lab_h.error_outputs(page)
     assert not errors, f"{name}: an error was reported during the drag:\n" + "\n----\n".join(errors)
+
+
+def _readout_value(page) -> float:
+    """The value the first slider's readout shows (its minus sign may be U+2212)."""
+    text = lab_h.first_slider(page).locator(".widget-readout").inner_text()
+    return float(text.strip().replace("\u2212", "-"))
 
 
 def _pixels(png: bytes) -> np.ndarray:
