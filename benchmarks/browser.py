@@ -33,7 +33,7 @@ sys.path.insert(0, str(ROOT / "tests"))
 
 import lab_harness as lab_h  # noqa: E402  (lives with the browser test)
 
-__all__ = ["FLOOR_SOURCE", "LIGHT_MS", "run_browser"]
+__all__ = ["FLOOR_SOURCE", "LIGHT_MS", "require_browser", "run_browser"]
 
 FLOOR_SOURCE = [
     "%matplotlib inline\nimport numpy as np\nimport matplotlib.pyplot as plt\n"
@@ -129,13 +129,19 @@ def _write_notebooks(root: Path, explorers: list[str]) -> None:
             f"%matplotlib inline\nfrom coursekit.explorers.{module} import {factory}", f"{factory}()"])
 
 
+def require_browser() -> None:
+    """Stop with the fix when Playwright or Chromium is missing."""
+    reason = lab_h.missing_reason()
+    if reason:
+        raise SystemExit(f"browser benchmark: {reason}")
+
+
 def run_browser(explorers: list[str], kernel_ms: dict, *, steps: int = 15,
                 shots: Path | None = None, log=print) -> list[str]:
     """Measure every explorer (labels ``chN.factory``) and the floor; the markdown table rows.
     `kernel_ms` holds each explorer's compute + redraw time (ms), which makes it light or not."""
-    reason = lab_h.missing_reason()
-    if reason:
-        raise SystemExit(f"browser benchmark: {reason}")
+    require_browser()
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
     results: dict[str, list[dict]] = {}
     with tempfile.TemporaryDirectory(prefix="coursekit-browser-bench-") as tmp:
         base = Path(tmp)
@@ -146,8 +152,11 @@ def run_browser(explorers: list[str], kernel_ms: dict, *, steps: int = 15,
             for label in _schedule(explorers):
                 start = time.monotonic()
                 scope = FLOOR_SCOPE if label == "floor" else lab_h.EXPLORER
-                results.setdefault(label, []).append(
-                    measure_notebook(page, url, f"{label}.ipynb", scope, steps, shots))
+                try:
+                    result = measure_notebook(page, url, f"{label}.ipynb", scope, steps, shots)
+                except (lab_h.HarnessError, PlaywrightTimeout) as error:
+                    raise SystemExit(f"browser benchmark, {label}: {error}") from error
+                results.setdefault(label, []).append(result)
                 log(f"  {label}: {time.monotonic() - start:.0f} s")
     return _table(explorers, kernel_ms, results)
 

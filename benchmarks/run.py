@@ -261,6 +261,7 @@ def bench_browser(steps: int, shots: Path | None = None) -> list[str]:
     most browser.LIGHT_MS."""
     sys.path.insert(0, str(ROOT / "benchmarks"))
     import browser
+    browser.require_browser()
     factories = dict(explorer_factories())
     kernel_ms = {}
     for label, factory in factories.items():
