@@ -4,6 +4,8 @@ Run from the repository root (with the `dev` extra installed):
 
     python benchmarks/run.py            # everything
     python benchmarks/run.py --quick    # fewer repetitions, no notebooks
+    python benchmarks/run.py --browser  # everything, plus the browser benchmark
+    python benchmarks/run.py --browser-only   # only the browser benchmark (benchmarks/browser.py)
 
 Each pair of competitors is timed in interleaved repetitions (a, b, a, b, ...)
 so that drift in the machine's speed affects both alike; the table reports
@@ -253,11 +255,35 @@ def bench_import(repeat: int) -> list[str]:
             f"| coursekit (includes numpy; target < 500 ms) | {ms(med['coursekit'])} |"]
 
 
+def bench_browser(steps: int, shots: Path | None = None) -> list[str]:
+    """Each explorer and the trivial-interact floor in JupyterLab + headless Chromium (see
+    benchmarks/browser.py); an explorer is light when its compute + redraw, timed here, is at
+    most browser.LIGHT_MS."""
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    import browser
+    browser.require_browser()
+    factories = dict(explorer_factories())
+    kernel_ms = {}
+    for label, factory in factories.items():
+        explorer = factory()
+        kernel_ms[label] = 1e3 * interleaved({"refresh": explorer.refresh}, 11)["refresh"]
+    return browser.run_browser(list(factories), kernel_ms, steps=steps, shots=shots,
+                               log=lambda line: print(line, file=sys.stderr))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer repetitions, skip notebooks")
+    parser.add_argument("--browser", action="store_true",
+                        help="add the browser benchmark (JupyterLab + headless Chromium)")
+    parser.add_argument("--browser-only", action="store_true", help="run only the browser benchmark")
+    parser.add_argument("--screenshots", type=Path, default=None, metavar="DIR",
+                        help="browser benchmark: save a screenshot of each notebook after its drag")
     args = parser.parse_args()
     repeat = 5 if args.quick else 21
+    steps = 7 if args.quick else 15
+    browser_section = ("browser: JupyterLab + headless Chromium, 1600x1000, first slider of each explorer",
+                       lambda reps: bench_browser(reps, args.screenshots), steps)
     sections = [
         ("simulate: 10 001 samples, one input", bench_simulate, repeat),
         ("place: single input, poles -1..-3", bench_place, repeat),
@@ -266,6 +292,10 @@ def main() -> None:
     ]
     if not args.quick:
         sections.append(("notebooks (fresh kernel each run)", bench_notebooks, 3))
+    if args.browser:
+        sections.append(browser_section)
+    if args.browser_only:
+        sections = [browser_section]
     print(f"coursekit benchmarks, Python {sys.version.split()[0]}, numpy {np.__version__}\n")
     for title, func, reps in sections:
         print(f"### {title} (median of {reps})\n")

@@ -1,0 +1,183 @@
+"""The browser benchmark: what a student feels when moving an explorer's slider.
+
+JupyterLab on a loopback port, headless Chromium at 1600x1000 (the harness of the browser
+test, ``tests/lab_harness.py``). Each explorer runs alone in a small generated notebook
+(its import and one call of its factory); the floor is a trivial ``interact`` whose function
+plots one line and calls ``plt.show()`` (``%matplotlib inline``, ipywidgets' default
+``continuous_update=True``), the fastest a slider-driven figure gets in the same JupyterLab. Measured in the page, on the page's clock:
+
+* step: focus the first slider's handle, press an arrow key, time from the key event to the
+  paint of the last new figure (the first animation frame after the ``<img>``'s ``load``),
+  once the figure has been quiet for 0.4 s. The key steps towards the far end of the range
+  so the values are new ones until the end is reached;
+* drag: mouse down on that handle, a move every 16 ms, to 90 % of the way to the far end of
+  the track and back, 2.5 trips in 3 s; new figures painted between mouse down and mouse up
+  per second, next to the slider values the hand passed per second;
+* lag after release: from mouse up to the paint of the last figure, once the figure has not
+  changed for 1 s (0 when nothing changed after the release).
+
+The floor runs before the first explorer and after every third one, so drift in the
+machine's speed affects both; its row pools those runs.
+"""
+
+from __future__ import annotations
+
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests"))
+
+import lab_harness as lab_h  # noqa: E402  (lives with the browser test)
+
+__all__ = ["FLOOR_SOURCE", "LIGHT_MS", "require_browser", "run_browser"]
+
+FLOOR_SOURCE = [
+    "%matplotlib inline\nimport numpy as np\nimport matplotlib.pyplot as plt\n"
+    "from ipywidgets import interact, FloatSlider\nt = np.linspace(0, 10, 500)",
+    "def plot(a):\n    plt.plot(t, np.sin(a * t))\n    plt.show()\n\n"
+    "interact(plot, a=FloatSlider(value=1.0, min=0.1, max=5.0, step=0.1));",
+]
+FLOOR_SCOPE = ".jp-NotebookPanel:not(.lm-mod-hidden) .jp-CodeCell:has(.widget-slider) .jp-Cell-outputArea"
+LIGHT_MS = 25.0      # kernel compute + redraw at most this: "light", target 20 updates/s
+DRAG_S = 3.0
+RUN_TIMEOUT_S = 120
+STEP_QUIET_MS = 400
+
+
+def _paint_count(page) -> int:
+    return page.evaluate("() => window.__ckProbe.paints.length")
+
+
+def measure_steps(page, slider, count: int) -> list[float]:
+    """Milliseconds from each of `count` arrow-key presses to its last new figure painted."""
+    handle = slider.locator(".noUi-handle").first
+    handle.focus()
+    aria = lambda: handle.evaluate("h => ['now', 'min', 'max'].map(k => h.getAttribute('aria-value' + k))")
+    now, low, high = map(float, aria())
+    key = "ArrowRight" if now - low <= high - now else "ArrowLeft"
+    latencies = []
+    for _ in range(count):
+        now, low, high = aria()     # rounded alike, so equal at the end of the range
+        key = "ArrowLeft" if now == high else "ArrowRight" if now == low else key
+        before = _paint_count(page)
+        page.keyboard.press(key)
+        try:
+            page.wait_for_function(f"() => window.__ckProbe.paints.length > {before}", timeout=30_000)
+        except Exception as error:   # playwright's TimeoutError
+            raise lab_h.HarnessError(f"no new figure within 30 s of pressing {key}") from error
+        state = lab_h.wait_until_quiet(page, quiet_ms=STEP_QUIET_MS, timeout=60)
+        pressed = max(i["t"] for i in state["inputs"] if i["type"] == "keydown")
+        latencies.append(state["paints"][-1]["t"] - pressed)
+    return latencies
+
+
+def measure_drag(page, slider) -> dict:
+    """Figures painted per second during a 3 s drag, slider values per second, lag after release."""
+    lab_h.drag(page, slider, seconds=DRAG_S, trips=2.5)
+    state = lab_h.wait_until_quiet(page, quiet_ms=1000, timeout=90)
+    down = max(i["t"] for i in state["inputs"] if i["type"] == "mousedown")
+    up = max(i["t"] for i in state["inputs"] if i["type"] == "mouseup")
+    seconds = (up - down) / 1e3
+    texts = [r["text"] for r in state["readouts"] if down <= r["t"] <= up]
+    changes = sum(a != b for a, b in zip(texts, texts[1:])) + bool(texts)
+    paints = [p["t"] for p in state["paints"] if p["t"] > down]
+    return {"updates": sum(t <= up for t in paints) / seconds, "values": changes / seconds,
+            "lag": max(0.0, paints[-1] - up) if paints else float("nan")}
+
+
+def measure_notebook(page, url: str, name: str, scope: str, steps: int, shots: Path | None) -> dict:
+    """Open, run, measure steps and a drag on the first slider of `scope`; close and stop the kernel."""
+    try:
+        lab_h.open_notebook(page, name)
+        lab_h.run_all(page)
+        lab_h.wait_until_done(page, RUN_TIMEOUT_S)
+        errors = lab_h.error_outputs(page)
+        if errors:
+            raise lab_h.HarnessError(f"{name} reported an error:\n" + "\n".join(errors))
+        page.locator(f"{scope} img").first.wait_for(timeout=30_000)
+        slider = lab_h.first_slider(page, scope)
+        lab_h.install_probe(page)
+        result = {"steps": measure_steps(page, slider, steps)}
+        result.update(measure_drag(page, slider))
+        if shots is not None:
+            page.screenshot(path=str(shots / f"{Path(name).stem}.png"))
+        return result
+    finally:
+        lab_h.close_all(page)
+        lab_h.shut_down_kernels(url)
+
+
+def _schedule(explorers: list[str]) -> list[str]:
+    """The floor first and after every third explorer (and last)."""
+    order = ["floor"]
+    for i, label in enumerate(explorers, 1):
+        order.append(label)
+        if i % 3 == 0 or i == len(explorers):
+            order.append("floor")
+    return order
+
+
+def _write_notebooks(root: Path, explorers: list[str]) -> None:
+    lab_h.write_notebook(root / "floor.ipynb", FLOOR_SOURCE)
+    for label in explorers:
+        module, factory = label.split(".")
+        lab_h.write_notebook(root / f"{label}.ipynb", [
+            f"%matplotlib inline\nfrom coursekit.explorers.{module} import {factory}", f"{factory}()"])
+
+
+def require_browser() -> None:
+    """Stop with the fix when Playwright or Chromium is missing."""
+    reason = lab_h.missing_reason()
+    if reason:
+        raise SystemExit(f"browser benchmark: {reason}")
+
+
+def run_browser(explorers: list[str], kernel_ms: dict, *, steps: int = 15,
+                shots: Path | None = None, log=print) -> list[str]:
+    """Measure every explorer (labels ``chN.factory``) and the floor; the markdown table rows.
+    `kernel_ms` holds each explorer's compute + redraw time (ms), which makes it light or not."""
+    require_browser()
+    from playwright.sync_api import TimeoutError as PlaywrightTimeout
+    results: dict[str, list[dict]] = {}
+    with tempfile.TemporaryDirectory(prefix="coursekit-browser-bench-") as tmp:
+        base = Path(tmp)
+        (base / "root").mkdir()
+        _write_notebooks(base / "root", explorers)
+        with lab_h.running_lab(base / "root", base) as url, lab_h.launched_chromium() as browser:
+            page = lab_h.new_lab_page(browser, url)
+            for label in _schedule(explorers):
+                start = time.monotonic()
+                scope = FLOOR_SCOPE if label == "floor" else lab_h.EXPLORER
+                try:
+                    result = measure_notebook(page, url, f"{label}.ipynb", scope, steps, shots)
+                except (lab_h.HarnessError, PlaywrightTimeout) as error:
+                    raise SystemExit(f"browser benchmark, {label}: {error}") from error
+                results.setdefault(label, []).append(result)
+                log(f"  {label}: {time.monotonic() - start:.0f} s")
+    return _table(explorers, kernel_ms, results)
+
+
+def _table(explorers: list[str], kernel_ms: dict, results: dict) -> list[str]:
+    floor_steps = [t for run in results["floor"] for t in run["steps"]]
+    floor = statistics.median(floor_steps)
+    rows = ["| explorer | kernel compute + redraw | step median | step max "
+            "| step / floor (target <= 1.3) | updates/s while dragging (target >= 10, light >= 20) "
+            "| slider values/s during the drag | lag after release |",
+            "|---|---|---|---|---|---|---|---|"]
+    runs = results["floor"]
+    rows.append(f"| floor: `interact`, one line, continuous_update=True ({len(runs)} runs) | - "
+                f"| {floor:.0f} ms | {max(floor_steps):.0f} ms | 1.00 "
+                f"| {statistics.median(r['updates'] for r in runs):.1f} "
+                f"| {statistics.median(r['values'] for r in runs):.0f} "
+                f"| {statistics.median(r['lag'] for r in runs):.0f} ms |")
+    for label in explorers:
+        run = results[label][0]
+        light = " (light)" if kernel_ms[label] <= LIGHT_MS else ""
+        rows.append(f"| {label}{light} | {kernel_ms[label]:.0f} ms | {statistics.median(run['steps']):.0f} ms "
+                    f"| {max(run['steps']):.0f} ms | {statistics.median(run['steps']) / floor:.2f} "
+                    f"| {run['updates']:.1f} | {run['values']:.0f} | {run['lag']:.0f} ms |")
+    return rows

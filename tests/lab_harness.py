@@ -1,0 +1,385 @@
+"""JupyterLab on loopback driven by headless Chromium: the parts the browser test and the
+browser benchmark (``benchmarks/run.py --browser``) share.
+
+* `running_lab` starts a JupyterLab server on a free 127.0.0.1 port serving a folder, and
+  stops it (by its process) at the end;
+* `open_notebook`, `run_all`, `wait_until_done`, `close_all`, `shut_down_kernels` drive the
+  application the way a user would (menus, tabs), with a timeout on every wait;
+* `install_probe` puts a recorder into the page that notes, in the page's own clock
+  (``performance.now()``), every key press and mouse press/release, every value shown by a
+  slider readout, and every new figure painted: an ``<img>`` that appears or gets a new
+  ``src``, timed at the first animation frame after its ``load`` event, which is when the
+  browser paints it;
+* `drag` moves a slider handle like a hand: mouse down, a move every 16 ms, mouse up.
+
+Every failure raises `HarnessError` with what was waited for; the test turns it into a test
+failure, the benchmark into a message.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import json
+import os
+import re
+import shutil
+import socket
+import subprocess
+import sys
+import time
+import urllib.request
+from pathlib import Path
+
+__all__ = ["CHROMIUM_ARGS", "TOKEN", "VIEWPORT", "HarnessError", "chromium_path", "missing_reason",
+           "write_notebook", "running_lab", "launched_chromium", "new_lab_page", "open_notebook",
+           "run_all", "wait_until_done", "close_all", "shut_down_kernels", "install_probe",
+           "probe_state", "execute_in_kernel", "EXPLORER", "first_slider", "drag", "wait_until_quiet",
+           "error_outputs"]
+
+CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
+                 "--disable-component-update", "--disable-sync", "--no-first-run"]
+TOKEN = "coursekit-browser-harness"
+VIEWPORT = {"width": 1600, "height": 1000}
+ACTIVE = ".jp-NotebookPanel:not(.lm-mod-hidden)"
+# the explorer's box: the class the explorer sets, or (older explorers) a widget box holding a figure
+EXPLORER = f"{ACTIVE} .ck-explorer, {ACTIVE} .widget-vbox:not(:has(.widget-vbox)):has(img)"
+
+
+class HarnessError(RuntimeError):
+    """Something the harness waited for did not happen (the message says what)."""
+
+
+def chromium_path() -> str | None:
+    for candidate in ("/usr/bin/chromium", shutil.which("chromium"), shutil.which("chromium-browser")):
+        if candidate and os.access(candidate, os.X_OK):
+            return candidate
+    return None
+
+
+def missing_reason() -> str | None:
+    """Why the browser cannot be driven here (with the fix), or None when it can."""
+    try:
+        import playwright.sync_api  # noqa: F401
+    except ImportError:
+        return "Playwright for Python is not installed (python -m pip install playwright)"
+    if chromium_path() is None:
+        return "Chromium is not installed (Debian/Ubuntu: apt-get install -y chromium)"
+    return None
+
+
+def write_notebook(path: Path, sources: list[str]) -> None:
+    """A notebook with one code cell per source string, for the python3 kernel."""
+    import nbformat
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nb.cells = [nbformat.v4.new_code_cell(src) for src in sources]
+    nbformat.write(nb, path)
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _write_settings(settings: Path) -> None:
+    """Render every cell (no windowing) and keep news/update pop-ups away."""
+    overrides = {
+        "@jupyterlab/notebook-extension/tracker.jupyterlab-settings": {"windowingMode": "none"},
+        "@jupyterlab/apputils-extension/notification.jupyterlab-settings":
+            {"fetchNews": "false", "checkForUpdates": False},
+    }
+    for rel, content in overrides.items():
+        path = settings / rel
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(content))
+
+
+@contextlib.contextmanager
+def running_lab(root: Path, base: Path):
+    """Serve `root` with JupyterLab on a free loopback port; yields its URL. `base` (an empty
+    temporary folder) takes the settings, runtime files and the server log."""
+    _write_settings(base / "settings")
+    port = _free_port()
+    cmd = [sys.executable, "-m", "jupyterlab", "--no-browser", "--ServerApp.open_browser=False",
+           "--ServerApp.ip=127.0.0.1", f"--ServerApp.port={port}", "--ServerApp.port_retries=0",
+           f"--ServerApp.root_dir={root}", f"--IdentityProvider.token={TOKEN}",
+           f"--LabApp.user_settings_dir={base / 'settings'}", f"--LabApp.workspaces_dir={base / 'workspaces'}",
+           "--LabApp.expose_app_in_browser=True"]
+    if hasattr(os, "geteuid") and os.geteuid() == 0:
+        cmd.append("--allow-root")
+    env = dict(os.environ, JUPYTER_CONFIG_DIR=str(base / "config"), JUPYTER_RUNTIME_DIR=str(base / "runtime"),
+               MPLBACKEND="module://matplotlib_inline.backend_inline")
+    log_path = base / "server.log"
+    with open(log_path, "w") as log:
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, env=env, cwd=root)
+        url = f"http://127.0.0.1:{port}"
+        try:
+            _wait_for_server(url, proc, log_path)
+            yield url
+        finally:
+            proc.terminate()
+            try:
+                proc.wait(timeout=20)
+            except subprocess.TimeoutExpired:
+                proc.kill()
+                proc.wait(timeout=20)
+
+
+def _wait_for_server(url: str, proc: subprocess.Popen, log: Path, timeout: float = 90.0) -> None:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if proc.poll() is not None:
+            raise HarnessError(f"JupyterLab exited with code {proc.returncode}:\n{log.read_text()[-3000:]}")
+        try:
+            with urllib.request.urlopen(f"{url}/api/status?token={TOKEN}", timeout=2) as response:
+                if response.status == 200:
+                    return
+        except OSError:
+            time.sleep(0.5)
+    raise HarnessError(f"JupyterLab did not answer within {timeout:.0f} s:\n{log.read_text()[-3000:]}")
+
+
+@contextlib.contextmanager
+def launched_chromium():
+    """Headless Chromium (the system one, never a downloaded build) under Playwright."""
+    from playwright.sync_api import sync_playwright
+    with sync_playwright() as pw:
+        browser = pw.chromium.launch(executable_path=chromium_path(), args=CHROMIUM_ARGS, headless=True)
+        try:
+            yield browser
+        finally:
+            browser.close()
+
+
+def new_lab_page(browser, url: str, *, viewport: dict = VIEWPORT):
+    """A page with JupyterLab loaded and ready to open documents; uncaught page errors are
+    collected in ``page.ck_page_errors``."""
+    page = browser.new_page(viewport=viewport)
+    page.ck_page_errors = []
+    page.on("pageerror", lambda error: page.ck_page_errors.append(str(error)))
+    page.goto(f"{url}/lab?reset&token={TOKEN}")
+    page.wait_for_function("() => window.jupyterapp?.commands?.hasCommand('docmanager:open')",
+                           timeout=90_000)
+    return page
+
+
+# JavaScript run in the page ------------------------------------------------------------
+
+_PROMPTS_JS = f"""() => Array.from(document.querySelectorAll(
+    '{ACTIVE} .jp-CodeCell .jp-InputPrompt')).map(p => p.textContent.trim())"""
+
+_KERNEL_IDLE_JS = f"""() => document.querySelector(
+    '{ACTIVE} .jp-Notebook-ExecutionIndicator')?.dataset.status === 'idle'"""
+
+_ERRORS_JS = f"""() => Array.from(document.querySelectorAll('{ACTIVE} .jp-OutputArea-output'))
+    .filter(o => /Traceback|Error displaying widget/.test(o.textContent)
+                 || o.dataset.mimeType === 'application/vnd.jupyter.stderr')
+    .map(o => o.textContent.slice(0, 1500))"""
+
+# every error and stderr message of the kernel, also those of widget callbacks, which
+# JupyterLab shows in no cell
+_WATCH_KERNEL_JS = """() => {
+    const kernel = window.jupyterapp.shell.currentWidget.sessionContext.session.kernel;
+    window.__ckKernelErrors = [];
+    kernel.iopubMessage.connect((_, msg) => {
+        const c = msg.content;
+        if (msg.header.msg_type === 'error') {
+            window.__ckKernelErrors.push(`${c.ename}: ${c.evalue}`);
+        } else if (msg.header.msg_type === 'stream' && c.name === 'stderr') {
+            window.__ckKernelErrors.push(c.text);
+        }
+    });
+}"""
+
+
+def open_notebook(page, name: str) -> None:
+    """Open `name` in the already loaded JupyterLab (no page reload), wait for its kernel and
+    start recording the kernel's error output (see `error_outputs`)."""
+    page.evaluate("name => window.jupyterapp.commands.execute('docmanager:open', "
+                  "{path: name, factory: 'Notebook'})", name)
+    page.wait_for_function("name => Array.from(window.jupyterapp.shell.widgets('main'))"
+                           ".some(w => w.context?.path === name && w.isVisible)",
+                           arg=name, timeout=60_000)
+    page.evaluate("name => { const w = Array.from(window.jupyterapp.shell.widgets('main'))"
+                  ".find(w => w.context?.path === name); window.jupyterapp.shell.activateById(w.id); }",
+                  name)
+    page.wait_for_selector(f"{ACTIVE} .jp-Cell", timeout=60_000)
+    page.wait_for_function("name => Array.from(window.jupyterapp.shell.widgets('main'))"
+                           ".some(w => w.context?.path === name"
+                           " && w.sessionContext?.session?.kernel?.status === 'idle')",
+                           arg=name, timeout=90_000)
+    page.evaluate(_WATCH_KERNEL_JS)
+
+
+def error_outputs(page) -> list[str]:
+    """Tracebacks and stderr in the active notebook's outputs, error and stderr messages of its
+    kernel (widget callbacks included), and uncaught errors in the page."""
+    return (page.evaluate(_ERRORS_JS) + page.evaluate("() => window.__ckKernelErrors || []")
+            + list(page.ck_page_errors))
+
+
+def run_all(page) -> None:
+    """Run > Run All Cells; retried when the kernel did not pick it up (clicked too early)."""
+    for _ in range(3):
+        page.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
+        page.locator(".lm-Menu-item:visible", has_text="Run All Cells").first.click()
+        try:
+            page.wait_for_function(f"() => ({_PROMPTS_JS})().some(p => p.includes('*') || /\\d/.test(p))",
+                                   timeout=20_000)
+            return
+        except Exception:  # playwright's TimeoutError: nothing was queued yet
+            page.keyboard.press("Escape")
+    raise HarnessError("Run > Run All Cells did not start the kernel")
+
+
+def _executed(prompt: str) -> bool:
+    """True for an input prompt such as '[12]:' (the cell ran), False for '[ ]:' or '[*]:'."""
+    return re.fullmatch(r"\[\d+\]:?", prompt) is not None
+
+
+def wait_until_done(page, timeout: float) -> list[str]:
+    """Wait until the kernel has run every queued cell and is idle; return the input prompts."""
+    deadline = time.monotonic() + timeout
+    started = False
+    while time.monotonic() < deadline:
+        prompts = page.evaluate(_PROMPTS_JS)
+        busy = any("*" in p for p in prompts)
+        started = started or busy or (bool(prompts) and any(map(_executed, prompts)))
+        if started and not busy and page.evaluate(_KERNEL_IDLE_JS):
+            return prompts
+        page.wait_for_timeout(250)
+    raise HarnessError(f"cells still running after {timeout:.0f} s: prompts {page.evaluate(_PROMPTS_JS)}")
+
+
+def close_all(page) -> None:
+    """Save (into the served folder) and close every tab, so no 'unsaved changes' dialog appears."""
+    page.evaluate("""async () => {
+        for (const widget of Array.from(window.jupyterapp.shell.widgets('main'))) {
+            if (widget.context) { await widget.context.save(); }
+            widget.dispose();
+        }
+    }""")
+    page.wait_for_function("() => !document.querySelector('.jp-NotebookPanel')", timeout=30_000)
+
+
+def shut_down_kernels(url: str) -> None:
+    """Stop every kernel of the server so the next notebook has the machine to itself."""
+    with urllib.request.urlopen(f"{url}/api/kernels?token={TOKEN}", timeout=10) as response:
+        kernels = json.load(response)
+    for kernel in kernels:
+        request = urllib.request.Request(f"{url}/api/kernels/{kernel['id']}?token={TOKEN}", method="DELETE")
+        urllib.request.urlopen(request, timeout=30).close()
+
+
+_EXECUTE_JS = """async code => {
+    const kernel = window.jupyterapp.shell.currentWidget.sessionContext.session.kernel;
+    const future = kernel.requestExecute({code, silent: false, store_history: false});
+    const out = [];
+    future.onIOPub = msg => {
+        const c = msg.content;
+        if (msg.header.msg_type === 'stream') { out.push(c.text); }
+        if (msg.header.msg_type === 'error') { out.push(`${c.ename}: ${c.evalue}`); }
+    };
+    await future.done;
+    return out.join('');
+}"""
+
+
+def execute_in_kernel(page, code: str, timeout: float = 60.0) -> str:
+    """Run `code` in the active notebook's kernel (no cell is added); return what it printed."""
+    page.set_default_timeout(timeout * 1e3)
+    try:
+        return page.evaluate(_EXECUTE_JS, code)
+    finally:
+        page.set_default_timeout(30_000)
+
+
+# The probe: input events, slider readouts and figure paints, on the page's clock -----------
+
+_PROBE_JS = """() => {
+    const root = document.querySelector('.jp-NotebookPanel:not(.lm-mod-hidden) .jp-Notebook');
+    const probe = {paints: [], inputs: [], readouts: [], seen: new WeakMap()};
+    const paint = (img, src) => {
+        if (img.getAttribute('src') !== src || !img.isConnected) { return; }
+        requestAnimationFrame(() => probe.paints.push({t: performance.now(), src}));
+    };
+    const watch = img => {
+        const src = img.getAttribute('src');
+        if (!src || probe.seen.get(img) === src) { return; }
+        probe.seen.set(img, src);
+        img.addEventListener('load', () => paint(img, src), {once: true});
+    };
+    const imgs = node => node.nodeType !== 1 ? [] :
+        (node.tagName === 'IMG' ? [node] : Array.from(node.querySelectorAll('img')));
+    root.querySelectorAll('img').forEach(img => probe.seen.set(img, img.getAttribute('src')));
+    new MutationObserver(records => {
+        for (const r of records) {
+            if (r.type === 'attributes') { watch(r.target); }
+            r.addedNodes.forEach(n => imgs(n).forEach(watch));
+            const readout = (r.target.nodeType === 1 ? r.target : r.target.parentElement)
+                ?.closest?.('.widget-readout');
+            if (readout) { probe.readouts.push({t: performance.now(), text: readout.textContent}); }
+        }
+    }).observe(root, {subtree: true, childList: true, attributes: true, attributeFilter: ['src'],
+                      characterData: true});
+    for (const type of ['keydown', 'mousedown', 'mouseup']) {
+        document.addEventListener(type, e => probe.inputs.push({type, t: e.timeStamp}), true);
+    }
+    window.__ckProbe = probe;
+}"""
+
+
+def install_probe(page) -> None:
+    """Start recording inputs, readouts and figure paints in the active notebook (see module doc)."""
+    page.evaluate(_PROBE_JS)
+
+
+def probe_state(page) -> dict:
+    """Everything recorded so far: lists ``paints`` ({t, src}), ``inputs`` ({type, t}) and
+    ``readouts`` ({t, text}), plus ``now``, all in milliseconds of the page's clock."""
+    return page.evaluate("() => ({paints: window.__ckProbe.paints, inputs: window.__ckProbe.inputs,"
+                         " readouts: window.__ckProbe.readouts, now: performance.now()})")
+
+
+def first_slider(page, scope: str = EXPLORER):
+    """The first slider of the first explorer (or of whatever `scope` selects), scrolled into view."""
+    slider = page.locator(scope).first.locator(".widget-slider").first
+    slider.scroll_into_view_if_needed()
+    return slider
+
+
+def drag(page, slider, seconds: float = 3.0, *, trips: float = 1.5, reach: float = 0.9) -> None:
+    """Press the mouse on the slider's handle, move it in a 16 ms rhythm towards the far end of
+    the track (`reach` of the way) and back, `trips` times within `seconds` (a half trip ends
+    at the far end, away from the start value), then release."""
+    handle = slider.locator(".noUi-handle").first.bounding_box()
+    track = slider.locator(".noUi-target").first.bounding_box()
+    if handle is None or track is None:
+        raise HarnessError("the slider has no visible handle or track to drag")
+    x0, y = handle["x"] + handle["width"] / 2, handle["y"] + handle["height"] / 2
+    left, right = track["x"] + 2, track["x"] + track["width"] - 2
+    far = left if x0 - left > right - x0 else right
+    page.mouse.move(x0, y)
+    page.mouse.down()
+    start = time.perf_counter()
+    step = 0
+    while (elapsed := time.perf_counter() - start) < seconds:
+        phase = (elapsed * trips / seconds) % 1.0           # 0 -> 1 per trip
+        there = 2 * phase if phase < 0.5 else 2 - 2 * phase  # 0 -> 1 -> 0
+        page.mouse.move(x0 + reach * there * (far - x0), y)
+        step += 1
+        time.sleep(max(0.0, start + 0.016 * step - time.perf_counter()))
+    page.mouse.up()
+
+
+def wait_until_quiet(page, quiet_ms: float = 1000.0, timeout: float = 60.0) -> dict:
+    """Wait until no figure has been painted for `quiet_ms`; return `probe_state` then."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        state = probe_state(page)
+        last = max([p["t"] for p in state["paints"]] + [i["t"] for i in state["inputs"]], default=0.0)
+        if state["now"] - last >= quiet_ms:
+            return state
+        page.wait_for_timeout(100)
+    raise HarnessError(f"the figure kept changing for {timeout:.0f} s")
