@@ -185,8 +185,10 @@ def test_command_line_needs_out_and_reports_errors(tmp_path, capsys):
         main(["site"])
     assert stop.value.code == 2
     assert "--out" in capsys.readouterr().err
-    assert main(["site", "--out", str(tmp_path / "o"), "--notebooks", str(tmp_path / "none")]) == 1
-    assert "not a directory" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as stop:       # every command reports its errors alike
+        main(["site", "--out", str(tmp_path / "o"), "--notebooks", str(tmp_path / "none")])
+    assert stop.value.code == 2
+    assert "site: error:" in capsys.readouterr().err
 
 
 # --- one small build --------------------------------------------------------------------------
