@@ -194,3 +194,32 @@ def test_snapping_limits_set_by_hand_again_does_not_widen_them():
         assert snap_limits(ax, done=done) == done
     ax.set_xlim(-8.0, 8.0)              # set again by hand (an update): snapped again, alike
     assert snap_limits(ax, done=done) == done
+
+
+def test_settings_shown_before_come_from_the_frame_cache_and_the_artists_follow():
+    e = ch1.msd_explorer()
+    m = e.controls["m"]
+    first = e.png
+    m.value = 2.0
+    e.refresh()
+    second, draws = e.png, (e.frames.full_draws, e.frames.blits)
+    m.value = 1.0                        # dragged back: the frame is not drawn again
+    e.refresh()
+    assert e.png == first and (e.frames.full_draws, e.frames.blits) == draws
+    np.testing.assert_allclose(e.handles["y"].get_ydata(), ch1.msd_compute(m=1.0, d=0.5, k=2.0)["y"])
+    assert e.result["m"] == 1.0
+    m.value = 2.0
+    e.refresh()
+    assert e.png == second
+
+
+def test_the_frame_cache_is_bounded_and_dropped_when_the_resolution_changes():
+    from coursekit.explorers._base import FRAME_CACHE_SIZE
+    e = ch1.euler_explorer()
+    ts = e.controls["Ts"]
+    for k in range(FRAME_CACHE_SIZE + 5):
+        ts.value = round(ts.min + (k % 90) * ts.step, 2)
+        e.refresh()
+    assert len(e._cache) <= FRAME_CACHE_SIZE
+    _shown(e, width=300, height=300, ratio=1.0)
+    assert len(e._cache) == 1 and next(iter(e._cache))[1] == e.fig.dpi

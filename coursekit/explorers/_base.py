@@ -31,6 +31,7 @@ parameters instead of an empty widget area.
 from __future__ import annotations
 
 import base64
+from collections import OrderedDict
 from typing import Any, Callable
 
 from ._frames import FrameRenderer, encode_png
@@ -42,6 +43,9 @@ MIN_SCALE = 0.45
 
 #: in lecture mode an explorer grows up to this factor to fill the room it has
 LECTURE_MAX_SCALE = 2.0
+
+#: how many recent frames an explorer keeps, for settings shown again
+FRAME_CACHE_SIZE = 128
 
 
 def _control_layout():
@@ -143,7 +147,9 @@ class Explorer:
         self._update(self.handles, self.result)
         self.frames = FrameRenderer(self.fig)
         self._update(self.handles, self.result)
+        self._cache: OrderedDict = OrderedDict()
         self._png = self.frames.frame()
+        self._remember()
         self._widget = None
         self._view = None
 
@@ -158,10 +164,32 @@ class Explorer:
         return self._png
 
     def refresh(self) -> None:
-        """Recompute for the current control values and redraw the figure."""
+        """Recompute for the current control values and redraw the figure.
+
+        Settings shown before (a slider dragged back over its values) come from a small cache
+        of recent frames, keyed by the settings and the resolution, instead of being computed
+        and drawn again; the figure's artists are still updated, so they always match what is
+        shown.
+        """
+        key = self._frame_key()
+        cached = self._cache.get(key)
+        if cached is not None:
+            self._cache.move_to_end(key)
+            self.result, self._png = cached
+            self._update(self.handles, self.result)
+            self._send()
+            return
         self.result = self._compute(**self.params)
         self._update(self.handles, self.result)
         self._show()
+
+    def _frame_key(self):
+        return tuple(self.params.items()), self.fig.dpi
+
+    def _remember(self) -> None:
+        self._cache[self._frame_key()] = (self.result, self._png)
+        while len(self._cache) > FRAME_CACHE_SIZE:
+            self._cache.popitem(last=False)
 
     def static_png(self) -> bytes:
         """The figure for the current settings at its natural size (what a static page shows)."""
@@ -175,7 +203,12 @@ class Explorer:
         return png
 
     def _show(self) -> None:
+        """Draw a frame of the figure as it is now, remember it and send it to the view."""
         self._png = self.frames.frame()
+        self._remember()
+        self._send()
+
+    def _send(self) -> None:
         if self._view is not None:
             ratio = float(self.screen.get("ratio") or 1.0)
             height, width = self.frames.canvas.buffer_rgba().shape[:2]
@@ -197,6 +230,7 @@ class Explorer:
         dpi = self.natural_dpi * _fit_scale(natural, self.screen, largest) * ratio
         if abs(dpi - self.fig.dpi) > 1e-6:
             self.fig.set_dpi(dpi)
+            self._cache.clear()          # frames at the old resolution are not shown again
         self._show()
 
     def _settings(self) -> str:
