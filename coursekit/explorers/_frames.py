@@ -7,13 +7,16 @@ those once into a background (matplotlib's blitting: the moving artists are
 marked *animated*, so a normal draw leaves them out, and are drawn on top of a
 restored copy of the background), and draws the whole figure again only when
 something in the background changes: a view limit, an axis label, the figure
-size or resolution, the number of lines of a moving text.
+size or resolution, the number of lines of a moving text. (A figure with an
+axes of fixed aspect ratio, whose limits follow its place, is drawn whole.) The
+layout that matplotlib's constrained layout finds for a full draw is kept per
+state of the text around the axes, so a state seen before is not measured again.
 
 Two rules make every frame identical to a full draw of the same figure:
 
-* view limits are widened to the nearest major tick outside them
-  (`snap_limits`), so they change in steps while a parameter moves and the
-  background is reused between the steps;
+* view limits are widened to round numbers outside them (`snap_limits`), so
+  they change in steps while a parameter moves and the background is reused
+  between the steps;
 * in each axes, every artist drawn after the first moving one (matplotlib draws
   an axes' children by zorder) is redrawn with it: a legend above a moving
   curve, or the axes frame, stays on top as in a full draw.
@@ -32,6 +35,9 @@ import numpy as np
 
 __all__ = ["FrameRenderer", "snap_limits", "encode_png"]
 
+#: how many layouts a renderer keeps (one per state of the text around the axes)
+LAYOUTS_KEPT = 64
+
 
 def encode_png(rgba, dpi: float) -> bytes:
     """PNG bytes of an RGBA buffer, fast: zlib level 1 (half the time of the default level, for a
@@ -47,8 +53,13 @@ def encode_png(rgba, dpi: float) -> bytes:
 
 
 def _outer_ticks(axis, lo: float, hi: float) -> tuple[float, float]:
-    """The nearest major ticks of `axis` at or outside [lo, hi] (lo, hi themselves if none)."""
-    ticks = np.asarray(axis.get_major_locator().tick_values(lo, hi), dtype=float)
+    """The nearest round numbers at or outside [lo, hi]: on a linear axis multiples of a step
+    of about a quarter of the range (1, 2, 2.5 or 5 times a power of ten), so that the limits
+    change only every few ticks; on a log axis the axis' own ticks (decades). (lo, hi) if none."""
+    from matplotlib.ticker import MaxNLocator
+    locator = MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]) if axis.get_scale() == "linear" \
+        else axis.get_major_locator()
+    ticks = np.asarray(locator.tick_values(lo, hi), dtype=float)
     tol = 1e-9 * (hi - lo)
     below, above = ticks[ticks <= lo + tol], ticks[ticks >= hi - tol]
     return (below.max() if below.size else lo), (above.min() if above.size else hi)
@@ -66,10 +77,10 @@ def snap_limits(ax, *, done=None) -> dict:
     """Put the view limits of `ax` on round numbers that change in steps, not continuously.
 
     The data range of an autoscaled axis, or the limits of an axis set by hand,
-    are widened to the nearest major ticks (the axis' own locator, linear or log
-    alike) plus the axes' usual margin, so that no tick label sits on a corner.
-    The limits then stay put while the data move between ticks. An axes with a
-    fixed aspect ratio then widens one of them, as it would when drawn.
+    are widened to the nearest round numbers (`_outer_ticks`) plus the axes' usual
+    margin, so that no tick label sits on a corner. The limits then stay put while
+    the data move between those numbers. (An axes with a fixed aspect ratio
+    widens one of them further when it is drawn.)
 
     `done` is what the previous call returned: limits set by hand that are still
     the snapped ones are left as they are (snapping them again would widen them
@@ -95,7 +106,6 @@ def snap_limits(ax, *, done=None) -> dict:
         snapped = _with_margin(axis, *_outer_ticks(axis, lo, hi), margins[name])
         if np.all(np.isfinite(snapped)) and snapped[0] < snapped[1]:   # not on a log axis with data <= 0
             set_(snapped[::-1] if flipped else snapped, auto=None)
-    ax.apply_aspect()
     return {"x": ax.get_xlim(), "y": ax.get_ylim()}
 
 
@@ -145,7 +155,7 @@ class FrameRenderer:
         self._background = None
         self._key = None
         self._snapped: dict = {}           # the limits snap_limits left, by axes
-        self._laid_out = None              # the text shape the layout was last found for
+        self._layouts: dict = {}           # axes places found by the layout engine, by state
         self.full_draws = 0
         self.blits = 0
         self.forget_changes()
@@ -162,7 +172,10 @@ class FrameRenderer:
         for ax in self.fig.axes:
             self._snapped[ax] = snap_limits(ax, done=self._snapped.get(ax))
         moving = self._changed_units()
-        if self._background is None or not moving <= self._moving or self._layout_key() != self._key:
+        if (self._background is None or not moving <= self._moving or self._layout_key() != self._key
+                or self._fixed_aspect()):
+            # an axes with a fixed aspect ratio sets its limits from its place as it is drawn:
+            # such a figure is drawn whole every time
             self._full_draw(self._moving | moving)
         else:
             self._blit()
@@ -233,43 +246,54 @@ class FrameRenderer:
         self.full_draws += 1
 
     def _draw_background(self) -> None:
-        """Draw the figure; lay it out again only when the text around its axes changed shape.
+        """Draw the figure, laying it out only for a state not laid out before.
 
-        Constrained layout measures every tick label and title: as much work again as the draw.
-        The margins it finds depend only on the size of that text, so while the tick labels keep
-        their shape (digits alike, a font's digits are all equally wide), the axis labels their
-        text and the titles their number of lines, the layout found before is still the one it
-        would find, and the draw goes without it.
+        Constrained layout measures every tick label and title: as much work again as the draw
+        itself. Its result depends only on what it measures, so it is kept for each state of the
+        text around the axes (view limits, scales, axis labels, the number of lines of the
+        titles and of the moving texts) and put back, without measuring, when a slider returns
+        to a state laid out before.
         """
         engine = self.fig.get_layout_engine()
-        shape = self._text_shape()
-        if engine is None or shape != self._laid_out:
+        if engine is None:
+            self.canvas.draw()
+            return
+        # an axes with a fixed aspect ratio sets its limits from its place: lay it out each time
+        state = None if self._fixed_aspect() else self._layout_state()
+        places = self._layouts.get(state)
+        if places is None:
             self._restart_layout()
             self.canvas.draw()
-            self._laid_out = shape
+            if state is None:
+                # the aspect sets the limits from the place before the layout moves the axes:
+                # a second draw lets both agree (matplotlib's own figures settle the same way)
+                self.canvas.draw()
+            if state is not None:
+                self._layouts[state] = [ax.get_position(original=True).bounds for ax in self.fig.axes]
+            while len(self._layouts) > LAYOUTS_KEPT:
+                self._layouts.pop(next(iter(self._layouts)))
             return
+        for ax, place in zip(self.fig.axes, places):
+            ax.set_position(place)
+            ax.set_in_layout(True)           # set_position takes an axes out of the layout
         self.fig.set_layout_engine("none")
         try:
             self.canvas.draw()
         finally:
             self.fig.set_layout_engine(engine)
 
-    def _text_shape(self):
-        """The size-relevant shape of the text a layout engine measures (see `_draw_background`)."""
-        digits = str.maketrans("0123456789", "0000000000")
+    def _fixed_aspect(self) -> bool:
+        return any(ax.get_aspect() != "auto" for ax in self.fig.axes)
 
-        def ticks(axis):
-            labels = axis.major.formatter.format_ticks(axis.major.locator())
-            return tuple(label.translate(digits) for label in labels), axis.get_offset_text().get_text()
-
+    def _layout_state(self):
+        """What the layout of the figure depends on, besides its fixed text (see `_draw_background`)."""
         def lines(text):
             return text.get_text().count("\n") if text.get_text() else -1
 
-        axes = tuple((ticks(ax.xaxis), ticks(ax.yaxis), ax.get_xlabel(), ax.get_ylabel(),
-                      tuple(lines(t) for t in (ax.title, *ax.texts)), ax.get_position(original=True).bounds)
+        axes = tuple((ax.get_xlim(), ax.get_ylim(), ax.get_xscale(), ax.get_yscale(), ax.get_xlabel(),
+                      ax.get_ylabel(), tuple(lines(t) for t in (ax.title, *ax.texts)), ax.get_visible())
                      for ax in self.fig.axes)
-        figure = tuple(lines(t) for t in self.fig.texts)
-        return tuple(self.fig.get_size_inches()), axes, figure
+        return tuple(self.fig.get_size_inches()), axes, tuple(lines(t) for t in self.fig.texts)
 
     def _restart_layout(self) -> None:
         """Put each axes back in its grid cell before a layout engine places it: constrained
