@@ -67,3 +67,19 @@ def test_explorers_build_label_and_refresh(factory):
     e.refresh()
     assert e.params[name] == widget.max and e.result is not before
     assert widget.continuous_update is True   # the figure follows the slider while it is dragged
+
+
+def test_integral_action_responses_are_linear_in_d_and_the_axes_hold_the_largest_d():
+    one = ch3.integral_action_compute(d=1.0, integral_pole=-1.5)
+    two = ch3.integral_action_compute(d=-2.5, integral_pole=-1.5)
+    for key in ("y_plain", "y_int", "u_plain", "u_int"):
+        np.testing.assert_allclose(two[key], -2.5 * one[key], atol=1e-12)
+    assert one["y_per_d"] == max(np.abs(one["y_plain"]).max(), np.abs(one["y_int"]).max())
+    zero = ch3.integral_action_compute(d=0.0, integral_pole=-1.5)
+    assert not np.any(zero["y_plain"]) and zero["y_per_d"] == one["y_per_d"]
+    e = ch3.integral_action_explorer()
+    limits = e.handles["ax_y"].get_ylim()
+    e.controls["d"].value = 0.25
+    e.refresh()
+    assert e.handles["ax_y"].get_ylim() == limits       # a smaller d draws a smaller response
+    assert limits[1] >= ch3.INTEGRAL_D_MAX * e.result["y_per_d"]

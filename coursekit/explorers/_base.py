@@ -183,6 +183,11 @@ class Explorer:
         self._update(self.handles, self.result)
         self._show()
 
+    def forget_frames(self) -> None:
+        """Forget the remembered frames, so that the next `refresh` computes and draws anew
+        (what a benchmark of the redraw times)."""
+        self._cache.clear()
+
     def _frame_key(self):
         return tuple(self.params.items()), self.fig.dpi
 
@@ -230,7 +235,7 @@ class Explorer:
         dpi = self.natural_dpi * _fit_scale(natural, self.screen, largest) * ratio
         if abs(dpi - self.fig.dpi) > 1e-6:
             self.fig.set_dpi(dpi)
-            self._cache.clear()          # frames at the old resolution are not shown again
+            self.forget_frames()         # frames at the old resolution are not shown again
         self._show()
 
     def _settings(self) -> str:

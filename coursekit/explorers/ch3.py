@@ -33,6 +33,9 @@ __all__ = [
 PLACEMENT_A = np.array([[2.0, 0.0, 0.0], [1.0, -1.0, 2.0], [0.0, 2.0, -1.0]])
 PLACEMENT_B = np.array([[1.0], [0.0], [0.0]])
 
+#: the largest disturbance the integral-action explorer's slider offers (either sign)
+INTEGRAL_D_MAX = 3.0
+
 #: plant of the integral-action explorer: the CCF (3.27) with a0 = 6, a1 = -5
 INTEGRAL_A = np.array([[0.0, 1.0], [-6.0, 5.0]])
 INTEGRAL_B = np.array([[0.0], [1.0]])
@@ -221,7 +224,9 @@ def integral_action_compute(d: float = 1.0, integral_pole: float = -1.0, t_end: 
     keeps the offset (3.109); with an integrator on x1 the augmented poles
     are -1, -2 and `integral_pole` and the offset goes to zero. Returns
     ``t``, ``y_plain``, ``y_int`` (= x1), ``u_plain``, ``u_int``, the gains
-    ``K`` and ``K_E`` (= [k_I, k1, k2]) and the predicted ``offset`` of plain feedback.
+    ``K`` and ``K_E`` (= [k_I, k1, k2]), the predicted ``offset`` of plain feedback, and
+    ``y_per_d`` / ``u_per_d``, the largest |y| and |u| of both loops per unit of d (the
+    responses are linear in d).
     """
     d = as_scalar(d, "d")
     integral_pole = as_scalar(integral_pole, "integral_pole")
@@ -232,14 +237,18 @@ def integral_action_compute(d: float = 1.0, integral_pole: float = -1.0, t_end: 
     K = place(A, B, [-1.0, -2.0])
     A_E, B_E = integral_augment(A, B)
     K_E = place(A_E, B_E, [-1.0, -2.0, integral_pole])
-    dist = np.where(t >= 1.0, d, 0.0)
-    plain = simulate(StateSpace(A + B @ K, B), t, dist.reshape(-1, 1))
+    # both loops are linear and start at rest: their responses to d are d times those to d = 1
+    unit = np.where(t >= 1.0, 1.0, 0.0)
+    plain = simulate(StateSpace(A + B @ K, B), t, unit.reshape(-1, 1))
     loop = integral_closed_loop(A, B, K_E)
-    integ = simulate(loop, t, np.column_stack([dist, np.zeros_like(t)]))
+    integ = simulate(loop, t, np.column_stack([unit, np.zeros_like(t)]))
     # (3.109) for the state vector: x_inf = -(A + B K)^-1 B d
     offset = float(-np.linalg.solve(A + B @ K, B[:, 0] * d)[0])
-    return dict(t=t, y_plain=plain.x[:, 0], y_int=integ.y[:, 0], u_plain=plain.x @ K[0],
-                u_int=integ.x @ K_E[0], K=K, K_E=K_E, offset=offset, d=d)
+    y_unit = np.column_stack([plain.x[:, 0], integ.y[:, 0]])
+    u_unit = np.column_stack([plain.x @ K[0], integ.x @ K_E[0]])
+    return dict(t=t, y_plain=d * y_unit[:, 0], y_int=d * y_unit[:, 1], u_plain=d * u_unit[:, 0],
+                u_int=d * u_unit[:, 1], K=K, K_E=K_E, offset=offset, d=d,
+                y_per_d=float(np.abs(y_unit).max()), u_per_d=float(np.abs(u_unit).max()))
 
 
 def integral_action_explorer() -> Explorer:
@@ -266,12 +275,17 @@ def integral_action_explorer() -> Explorer:
         h["off"].set_ydata([r["offset"], r["offset"]])
         h["uplain"].set_data(r["t"], r["u_plain"])
         h["uint"].set_data(r["t"], r["u_int"])
-        rescale(h["ax_y"], h["ax_u"])
+        # axes that hold the largest disturbance of the slider: the response visibly grows with d
+        d_max = INTEGRAL_D_MAX
+        h["ax_y"].set_xlim(r["t"][0], r["t"][-1])
+        h["ax_u"].set_xlim(r["t"][0], r["t"][-1])
+        h["ax_y"].set_ylim(-d_max * r["y_per_d"], d_max * r["y_per_d"])
+        h["ax_u"].set_ylim(-d_max * r["u_per_d"], d_max * r["u_per_d"])
         h["ax_y"].set_title(f"step disturbance d = {r['d']:g} at t = 1 s; "
                             f"K_E = [{', '.join(f'{k:.3g}' for k in r['K_E'][0])}]")
 
     return Explorer(
         title="Integral action (3.110)-(3.120) on the CCF (3.27), a0 = 6, a1 = -5",
-        controls=dict(d=slider(1.0, -3.0, 3.0, 0.25, "disturbance d"),
+        controls=dict(d=slider(1.0, -INTEGRAL_D_MAX, INTEGRAL_D_MAX, 0.25, "disturbance d"),
                       integral_pole=slider(-1.0, -6.0, -0.2, 0.1, "integral pole [1/s]")),
         compute=integral_action_compute, draw=draw, update=update, figsize=(12, 4.5))
