@@ -689,6 +689,8 @@ bad("new_figure", "figsize negative", lambda: ck.new_figure(1, 1, figsize=(-4, 3
 ok("fit_margins", "good", lambda: ck.fit_margins(ck.new_figure()[0]))
 bad("fit_margins", "fig None", lambda: ck.fit_margins(None), "fig")
 bad("fit_margins", "fig an Axes", lambda: ck.fit_margins(ck.new_figure()[1]), "fig")
+ok("detect_host", "good", ck.detect_host)
+bad("detect_host", "called with an argument", lambda: ck.detect_host("colab"), "detect_host")
 ok("check_environment", "good", lambda: ck.check_environment(show=False))
 bad("check_environment", "show text", lambda: ck.check_environment(show="no"), "show")
 ok("EnvironmentReport", "ok", lambda: ck.check_environment(show=False).ok)
