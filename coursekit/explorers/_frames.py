@@ -52,13 +52,13 @@ def encode_png(rgba, dpi: float) -> bytes:
     return buf.getvalue()
 
 
-def _outer_ticks(axis, lo: float, hi: float) -> tuple[float, float]:
-    """The nearest round numbers at or outside [lo, hi]: on a linear axis multiples of a step
-    of about a quarter of the range (1, 2, 2.5 or 5 times a power of ten), so that the limits
-    change only every few ticks; on a log axis the axis' own ticks (decades). (lo, hi) if none."""
+def _outer_ticks(axis, lo: float, hi: float, *, coarse: bool) -> tuple[float, float]:
+    """The nearest round numbers at or outside [lo, hi]: the axis' own major ticks, or with
+    `coarse` on a linear axis multiples of a step of about a quarter of the range (1, 2, 2.5
+    or 5 times a power of ten), which change only every few ticks. (lo, hi) if none."""
     from matplotlib.ticker import MaxNLocator
-    locator = MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]) if axis.get_scale() == "linear" \
-        else axis.get_major_locator()
+    locator = MaxNLocator(nbins=4, steps=[1, 2, 2.5, 5, 10]) \
+        if coarse and axis.get_scale() == "linear" else axis.get_major_locator()
     ticks = np.asarray(locator.tick_values(lo, hi), dtype=float)
     tol = 1e-9 * (hi - lo)
     below, above = ticks[ticks <= lo + tol], ticks[ticks >= hi - tol]
@@ -76,9 +76,10 @@ def _with_margin(axis, lo: float, hi: float, margin: float) -> tuple[float, floa
 def snap_limits(ax, *, done=None) -> dict:
     """Put the view limits of `ax` on round numbers that change in steps, not continuously.
 
-    The data range of an autoscaled axis, or the limits of an axis set by hand,
-    are widened to the nearest round numbers (`_outer_ticks`) plus the axes' usual
-    margin, so that no tick label sits on a corner. The limits then stay put while
+    The data range of an autoscaled axis is widened to round numbers about a
+    quarter of the range apart, the limits of an axis set by hand to the nearest
+    major ticks (`_outer_ticks`), and both get the axes' usual margin, so that no
+    tick label sits on a corner. The limits then stay put while
     the data move between those numbers. (An axes with a fixed aspect ratio
     widens one of them further when it is drawn.)
 
@@ -103,7 +104,8 @@ def snap_limits(ax, *, done=None) -> dict:
             lo, hi = data
         elif not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
             continue
-        snapped = _with_margin(axis, *_outer_ticks(axis, lo, hi), margins[name])
+        # data ranges in coarse steps; limits set by hand (a time axis [0, T]) on the axis' ticks
+        snapped = _with_margin(axis, *_outer_ticks(axis, lo, hi, coarse=auto), margins[name])
         if np.all(np.isfinite(snapped)) and snapped[0] < snapped[1]:   # not on a log axis with data <= 0
             set_(snapped[::-1] if flipped else snapped, auto=None)
     return {"x": ax.get_xlim(), "y": ax.get_ylim()}
