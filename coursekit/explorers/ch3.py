@@ -281,7 +281,7 @@ def integral_action_explorer() -> Explorer:
         h["ax_u"].set_xlim(r["t"][0], r["t"][-1])
         h["ax_y"].set_ylim(-d_max * r["y_per_d"], d_max * r["y_per_d"])
         h["ax_u"].set_ylim(-d_max * r["u_per_d"], d_max * r["u_per_d"])
-        h["ax_y"].set_title(f"step disturbance d = {r['d']:g} at t = 1 s; "
+        h["ax_y"].set_title(f"step disturbance d = {r['d']:g} at t = 1 s\n"
                             f"K_E = [{', '.join(f'{k:.3g}' for k in r['K_E'][0])}]")
 
     return Explorer(
