@@ -108,7 +108,7 @@ def pole_placement_explorer() -> Explorer:
         h["u"].set_data(r["t"], r["u"])
         rescale(h["ax_x"], h["ax_u"])
         h["ax_x"].set_title(f"response from x0 = [1, 0, 0]\n{_gain_text(r['K'])}")
-        h["ax_u"].set_title(f"control effort u(t), max |u| = {r['max_u']:.3g}")
+        h["ax_u"].set_title(f"control effort u(t)\nmax |u| = {r['max_u']:.3g}")
 
     return Explorer(
         title="Pole placement (3.46)-(3.47) for the plant (3.22) driven by u1 only",
