@@ -12,12 +12,16 @@ other means.
 
 Two things constrained layout does not do, and `fit_margins` adds: a suptitle
 or an axes title wider than the figure breaks into lines instead of running
-off its edges. What it cannot do is keep a title wider than its own axes out of
-the neighbouring axes' title; coursekit's figures keep their titles short enough
+off its edges, and it breaks only at spaces outside mathtext, so that a
+formula in ``$...$`` is never cut in two (and its halves drawn as raw text).
+What it cannot do is keep a title wider than its own axes out of the
+neighbouring axes' title; coursekit's figures keep their titles short enough
 (or on two lines) for that, and a test checks every one of them.
 """
 
 from __future__ import annotations
+
+import functools
 
 __all__ = ["fit_margins"]
 
@@ -78,11 +82,13 @@ def _make_engine_class():
 
     class CourseLayout(ConstrainedLayoutEngine):
         """Constrained layout that first lets the suptitle and the axes titles wrap at the
-        figure's edges (matplotlib's ``Text.set_wrap``), so that none runs off the figure."""
+        figure's edges (matplotlib's ``Text.set_wrap``), so that none runs off the figure,
+        breaking their lines only at spaces outside mathtext (`_wrap_outside_math`)."""
 
         def execute(self, fig):
             for text in _titles(fig):
                 text.set_wrap(True)
+                text._get_wrapped_text = functools.partial(_wrap_outside_math, text)
             return super().execute(fig)
 
     return CourseLayout
@@ -96,3 +102,46 @@ def _titles(fig) -> list:
         texts += [ax.title, *(getattr(ax, name) for name in ("_left_title", "_right_title")
                               if hasattr(ax, name))]
     return texts
+
+
+def _wrap_outside_math(text) -> str:
+    """The string of `text` broken into lines that fit the figure, at spaces outside ``$...$``.
+
+    matplotlib's own wrapping (``Text._get_wrapped_text``, which this replaces on the titles)
+    breaks at any space, also inside a mathtext formula, whose halves are then drawn as raw
+    text with their dollar signs. Here a formula stays whole on one line; otherwise the
+    lines are filled the same way: as many words as fit the width matplotlib allows the
+    text (``Text._get_wrap_line_width``), measured as drawn.
+    """
+    if not text.get_wrap() or text.get_usetex():
+        return text.get_text()
+    width = text._get_wrap_line_width()
+    lines = []
+    for source_line in text.get_text().split("\n"):
+        words = _words_outside_math(source_line)
+        line = words[0]
+        for word in words[1:]:
+            longer = f"{line} {word}"
+            if text._get_rendered_text_width(longer) > width:
+                lines.append(line)
+                line = word
+            else:
+                line = longer
+        lines.append(line)
+    return "\n".join(lines)
+
+
+def _words_outside_math(line: str) -> list[str]:
+    """`line` split at the spaces outside its ``$...$`` formulas (at every space if its dollar
+    signs do not pair up, as matplotlib then draws it as plain text)."""
+    dollars = [k for k, char in enumerate(line) if char == "$" and (k == 0 or line[k - 1] != "\\")]
+    if len(dollars) < 2 or len(dollars) % 2:
+        return line.split(" ")
+    words, start, inside = [], 0, False
+    for k, char in enumerate(line):
+        if k in dollars:
+            inside = not inside
+        elif char == " " and not inside:
+            words.append(line[start:k])
+            start = k + 1
+    return words + [line[start:]]

@@ -118,3 +118,56 @@ def test_lecture_mode_figures_are_laid_out_too():
         assert text_problems(fig) == []
     finally:
         ck.lecture_mode(False)
+
+
+def _drawn_strings(fig) -> list[tuple[str, bool]]:
+    """(string, drawn as mathtext) for every line of text the Agg renderer draws."""
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    canvas = FigureCanvasAgg(fig)
+    renderer = canvas.get_renderer()
+    original, drawn = renderer.draw_text, []
+
+    def draw_text(gc, x, y, s, prop, angle, ismath=False, mtext=None):
+        drawn.append((s, bool(ismath)))
+        return original(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
+
+    renderer.draw_text = draw_text
+    try:
+        canvas.draw()
+    finally:
+        del renderer.draw_text
+    return drawn
+
+
+MATH_TITLE = (r"closed loop $\dot x = (A - B K)\, x$ with $K = [k_1 \quad k_2]$ "
+              r"from $x_0 = [1 \quad 0]^T$ for two gains")
+
+
+@pytest.mark.parametrize("lecture", [False, True], ids=["font size 18", "lecture mode"])
+def test_a_wrapped_title_with_mathtext_breaks_only_outside_the_math(lecture):
+    if lecture:
+        ck.lecture_mode()
+    try:
+        with matplotlib.rc_context({} if lecture else {"font.size": 18}):
+            fig, ax = ck.new_figure(figsize=(6, 4.5))
+            ax.plot(np.linspace(0, 10, 50), np.sin(np.linspace(0, 10, 50)))
+            ax.set_title(MATH_TITLE)
+            fig.suptitle(MATH_TITLE)
+            drawn = _drawn_strings(fig)
+            problems = text_problems(fig)
+    finally:
+        ck.lecture_mode(False)
+    titles = [s for s, _ in drawn if "gains" in s or "closed" in s]
+    assert len(titles) >= 4, drawn                 # both titles wrapped onto several lines
+    assert not [s for s, math in drawn if "$" in s and not math], drawn
+    assert problems == []
+
+
+@pytest.mark.parametrize("line, words", [
+    ("gain $k = 2$ and $x_0 = [1\\ 0]$ now", ["gain", "$k = 2$", "and", "$x_0 = [1\\ 0]$", "now"]),
+    (r"costs \$5 or \$6 a day", [r"costs", r"\$5", "or", r"\$6", "a", "day"]),
+    ("one $ sign only", ["one", "$", "sign", "only"]),
+])
+def test_titles_break_only_at_spaces_outside_formulas(line, words):
+    from coursekit.layout import _words_outside_math
+    assert _words_outside_math(line) == words
