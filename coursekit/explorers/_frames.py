@@ -76,10 +76,11 @@ def _with_margin(axis, lo: float, hi: float, margin: float) -> tuple[float, floa
 def snap_limits(ax, *, done=None) -> dict:
     """Put the view limits of `ax` on round numbers that change in steps, not continuously.
 
-    The data range of an autoscaled axis is widened to round numbers about a
-    quarter of the range apart, the limits of an axis set by hand to the nearest
-    major ticks (`_outer_ticks`), and both get the axes' usual margin, so that no
-    tick label sits on a corner. The limits then stay put while
+    The data range of an autoscaled axis, and limits set by hand that are not
+    on the axis' own ticks, are widened to round numbers about a quarter of the
+    range apart (`_outer_ticks`); limits set by hand on the axis' ticks (a time
+    axis [0, T]) are kept. All get the axes' usual margin, so that no tick label
+    sits on a corner. The limits then stay put while
     the data move between those numbers. (An axes with a fixed aspect ratio
     widens one of them further when it is drawn.)
 
@@ -104,8 +105,10 @@ def snap_limits(ax, *, done=None) -> dict:
             lo, hi = data
         elif not (np.isfinite(lo) and np.isfinite(hi) and lo < hi):
             continue
-        # data ranges in coarse steps; limits set by hand (a time axis [0, T]) on the axis' ticks
-        snapped = _with_margin(axis, *_outer_ticks(axis, lo, hi, coarse=auto), margins[name])
+        # limits set by hand on the axis' own ticks (a time axis [0, T]) stay; data ranges and
+        # limits that follow the data (a pole plot's extent) go to coarse round numbers
+        on_ticks = not auto and np.allclose(_outer_ticks(axis, lo, hi, coarse=False), (lo, hi))
+        snapped = _with_margin(axis, *_outer_ticks(axis, lo, hi, coarse=not on_ticks), margins[name])
         if np.all(np.isfinite(snapped)) and snapped[0] < snapped[1]:   # not on a log axis with data <= 0
             set_(snapped[::-1] if flipped else snapped, auto=None)
     return {"x": ax.get_xlim(), "y": ax.get_ylim()}
