@@ -18,7 +18,7 @@ import re
 import subprocess
 from pathlib import Path
 
-from .release import default_notebook_dir, read_notebook, write_notebook
+from .release import notebook_paths, read_notebook, write_notebook
 
 __all__ = ["INSTALL_MARK", "install_cell_source", "cell_repository", "with_install_cell",
            "apply_install_cell", "repository_from_git"]
@@ -119,11 +119,7 @@ def apply_install_cell(notebooks: Path | str | None = None, *, repository: str |
     only reports which notebooks would change.
     """
     install_cell_source(repository)   # validates the address before anything is written
-    folder = default_notebook_dir() if notebooks is None else Path(notebooks)
-    paths = sorted(folder.glob("*.ipynb"))
-    if not paths:
-        raise ValueError(f"no notebooks (*.ipynb) found in {folder}; pass the folder of the course "
-                         "notebooks (--notebooks on the command line).")
+    _, paths = notebook_paths(notebooks)
     changed = []
     for path in paths:
         nb = read_notebook(path)

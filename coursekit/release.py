@@ -34,6 +34,7 @@ __all__ = [
     "student_edition",
     "build_release",
     "default_notebook_dir",
+    "notebook_paths",
     "read_notebook",
     "write_notebook",
 ]
@@ -74,6 +75,17 @@ def default_notebook_dir() -> Path:
     """
     beside = Path(__file__).resolve().parents[1] / "notebooks"
     return beside if beside.is_dir() else Path.cwd() / "notebooks"
+
+
+def notebook_paths(notebooks=None) -> tuple[Path, list[Path]]:
+    """The folder of the course notebooks (`notebooks`, default `default_notebook_dir`) and its
+    ``*.ipynb`` files, sorted; ValueError when it holds none."""
+    folder = default_notebook_dir() if notebooks is None else Path(notebooks)
+    paths = sorted(folder.glob("*.ipynb"))
+    if not paths:
+        raise ValueError(f"no notebooks (*.ipynb) found in {folder}; pass the folder of the course "
+                         "notebooks (--notebooks on the command line).")
+    return folder, paths
 
 
 def read_notebook(path: Path | str):
@@ -166,11 +178,7 @@ def build_release(out: Path | str, *, notebooks: Path | str | None = None, force
     if not isinstance(force, bool):
         raise TypeError(f"force must be True or False: received {force!r}.")
     out = Path(out)
-    source = default_notebook_dir() if notebooks is None else Path(notebooks)
-    paths = sorted(source.glob("*.ipynb"))
-    if not paths:
-        raise ValueError(f"no notebooks (*.ipynb) found in {source}; pass the folder of the course "
-                         "notebooks (--notebooks on the command line).")
+    source, paths = notebook_paths(notebooks)
     _check_out_dir(out, source, force)
     out.mkdir(parents=True, exist_ok=True)
     written = []

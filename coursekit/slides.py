@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .release import default_notebook_dir, read_notebook, write_notebook
+from .release import notebook_paths, read_notebook, write_notebook
 
 __all__ = ["slide_type", "slide_types", "with_slide_metadata", "apply_slide_metadata"]
 
@@ -91,11 +91,7 @@ def apply_slide_metadata(notebooks: Path | str | None = None, *, write: bool = T
                         f"{type(notebooks).__name__}.")
     if not isinstance(write, bool):
         raise TypeError(f"write must be True or False: received {write!r}.")
-    folder = default_notebook_dir() if notebooks is None else Path(notebooks)
-    paths = sorted(folder.glob("*.ipynb"))
-    if not paths:
-        raise ValueError(f"no notebooks (*.ipynb) found in {folder}; pass the folder of the course "
-                         "notebooks (--notebooks on the command line).")
+    _, paths = notebook_paths(notebooks)
     changed = []
     for path in paths:
         nb = read_notebook(path)
