@@ -12,14 +12,17 @@ axes of fixed aspect ratio, whose limits follow its place, is drawn whole.) The
 layout that matplotlib's constrained layout finds for a full draw is kept per
 state of the text around the axes, so a state seen before is not measured again.
 
-Two rules make every frame identical to a full draw of the same figure:
+Three rules make every frame identical to a fresh draw of the same figure:
 
 * view limits are widened to round numbers outside them (`snap_limits`), so
   they change in steps while a parameter moves and the background is reused
   between the steps;
 * in each axes, every artist drawn after the first moving one (matplotlib draws
-  an axes' children by zorder) is redrawn with it: a legend above a moving
-  curve, or the axes frame, stays on top as in a full draw.
+  an axes' children by zorder) that can meet a moving one is redrawn with it:
+  a legend over a moving curve, or the axes frame, stays on top as in a full
+  draw, while a legend beside the axes stays in the background;
+* a full draw starts constrained layout from the axes' grid cells, so the same
+  state is laid out the same way whatever came before.
 
 The moving artists are found by matplotlib's own bookkeeping: setting data or
 text marks an artist *stale*, so after the explorer's update the stale artists
@@ -212,9 +215,9 @@ class FrameRenderer:
     # --- drawing -----------------------------------------------------------------------------
 
     def _redraw_list(self, moving: set) -> list | None:
-        """Per axes and then for the figure, the children from the first moving one on, in
-        zorder; None when a moving artist cannot be blitted (an image, or one that an axes or
-        axis is drawn after)."""
+        """Per axes and then for the figure, in zorder, the moving children and the still ones
+        drawn after the first moving one that can meet a moving one; None when a moving artist
+        cannot be blitted (an image, or one that an axes or axis is drawn after)."""
         from matplotlib.axes import Axes
         from matplotlib.axis import Axis
         from matplotlib.image import AxesImage
