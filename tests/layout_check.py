@@ -22,22 +22,21 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.text import Text
 from matplotlib.transforms import Bbox
 
-__all__ = ["TOLERANCE", "drawn_texts", "text_problems", "legend_problems"]
+__all__ = ["TOLERANCE", "drawn_texts", "drawn_strings", "text_problems", "legend_problems"]
 
 #: pixels a text may reach past the canvas or into another text (anti-aliasing, rounding)
 TOLERANCE = 1.0
 
 
-def _draw_recording(fig) -> tuple[list[Text], object]:
-    """Draw `fig` with Agg; return the Text artists in the order they were drawn, and the renderer."""
+def _draw_calling(fig, on_text) -> object:
+    """Draw `fig` with Agg, calling ``on_text(s, ismath, mtext)`` for every piece of text the
+    renderer draws; return the renderer."""
     canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
     renderer = canvas.get_renderer()
-    drawn: dict[int, Text] = {}
     original = renderer.draw_text
 
     def draw_text(gc, x, y, s, prop, angle, ismath=False, mtext=None):
-        if mtext is not None:
-            drawn.setdefault(id(mtext), mtext)
+        on_text(s, ismath, mtext)
         return original(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
 
     renderer.draw_text = draw_text
@@ -45,7 +44,21 @@ def _draw_recording(fig) -> tuple[list[Text], object]:
         canvas.draw()
     finally:
         del renderer.draw_text
-    return list(drawn.values()), canvas.get_renderer()
+    return canvas.get_renderer()
+
+
+def _draw_recording(fig) -> tuple[list[Text], object]:
+    """Draw `fig` with Agg; return the Text artists in the order they were drawn, and the renderer."""
+    drawn: dict[int, Text] = {}
+    renderer = _draw_calling(fig, lambda s, ismath, mtext: mtext is not None and drawn.setdefault(id(mtext), mtext))
+    return list(drawn.values()), renderer
+
+
+def drawn_strings(fig) -> list[tuple[str, bool]]:
+    """(string, drawn as mathtext) for every piece of text the Agg renderer draws in `fig`."""
+    drawn = []
+    _draw_calling(fig, lambda s, ismath, mtext: drawn.append((s, bool(ismath))))
+    return drawn
 
 
 def _owners(fig) -> dict[int, tuple[int, object]]:
@@ -133,7 +146,6 @@ def text_problems(fig) -> list[str]:
 def legend_problems(fig, *, covered: float = 0.15) -> list[str]:
     """Legends inside their axes that hide more than `covered` of the points of one of its
     labelled lines (in display space; the figure must have been drawn)."""
-    import numpy as np
     renderer = fig.canvas.get_renderer()
     problems = []
     for i, ax in enumerate(fig.axes):

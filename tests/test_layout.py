@@ -10,7 +10,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.layout_engine import ConstrainedLayoutEngine, TightLayoutEngine  # noqa: E402
 
 import coursekit as ck  # noqa: E402
-from layout_check import legend_problems, text_problems  # noqa: E402
+from layout_check import drawn_strings, legend_problems, text_problems  # noqa: E402
 
 
 def _crowded(fit: bool):
@@ -120,25 +120,6 @@ def test_lecture_mode_figures_are_laid_out_too():
         ck.lecture_mode(False)
 
 
-def _drawn_strings(fig) -> list[tuple[str, bool]]:
-    """(string, drawn as mathtext) for every line of text the Agg renderer draws."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    canvas = FigureCanvasAgg(fig)
-    renderer = canvas.get_renderer()
-    original, drawn = renderer.draw_text, []
-
-    def draw_text(gc, x, y, s, prop, angle, ismath=False, mtext=None):
-        drawn.append((s, bool(ismath)))
-        return original(gc, x, y, s, prop, angle, ismath=ismath, mtext=mtext)
-
-    renderer.draw_text = draw_text
-    try:
-        canvas.draw()
-    finally:
-        del renderer.draw_text
-    return drawn
-
-
 MATH_TITLE = (r"closed loop $\dot x = (A - B K)\, x$ with $K = [k_1 \quad k_2]$ "
               r"from $x_0 = [1 \quad 0]^T$ for two gains")
 
@@ -153,7 +134,7 @@ def test_a_wrapped_title_with_mathtext_breaks_only_outside_the_math(lecture):
             ax.plot(np.linspace(0, 10, 50), np.sin(np.linspace(0, 10, 50)))
             ax.set_title(MATH_TITLE)
             fig.suptitle(MATH_TITLE)
-            drawn = _drawn_strings(fig)
+            drawn = drawn_strings(fig)
             problems = text_problems(fig)
     finally:
         ck.lecture_mode(False)
