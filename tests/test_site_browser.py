@@ -14,9 +14,7 @@ present at all (student). Skipped, with the reason, without Playwright, Chromium
 from __future__ import annotations
 
 import html
-import os
 import re
-import shutil
 import socket
 import subprocess
 import sys
@@ -29,33 +27,23 @@ import pytest
 
 from coursekit import site
 
+import lab_harness  # the browser test's Chromium location and settings
+
 pytestmark = pytest.mark.browser
 
 NOTEBOOKS = Path(__file__).parents[1] / "notebooks"
 CHAPTERS = [p.stem for p in site.chapter_notebooks(NOTEBOOKS)]
 PAGES = ["index", *CHAPTERS, "genindex", "search"]
 EDITIONS = ["instructor", "student"]
-CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
-                 "--disable-component-update", "--disable-sync", "--no-first-run"]
 ERRATUM_BACKGROUND = "rgb(255, 247, 237)"   # coursekit.site.CSS, light mode
 _ERRATUM_SOURCE = re.compile(r"\*\*(?:Erratum|Remark\s*/\s*erratum)\b", re.IGNORECASE)
 _EXPLORER_CALL = re.compile(r"\b\w+_explorer\(")
 
 
-def _chromium() -> str | None:
-    for candidate in ("/usr/bin/chromium", shutil.which("chromium"), shutil.which("chromium-browser")):
-        if candidate and os.access(candidate, os.X_OK):
-            return candidate
-    return None
-
-
 def _skip_reason() -> str | None:
-    try:
-        import playwright.sync_api  # noqa: F401
-    except ImportError:
-        return "Playwright for Python is not installed (python -m pip install playwright)"
-    if _chromium() is None:
-        return "Chromium is not installed (Debian/Ubuntu: apt-get install -y chromium)"
+    reason = lab_harness.missing_reason()
+    if reason:
+        return reason
     missing = site.missing_site_tools()
     if missing:
         return "the site extra is not installed (python -m pip install -e \".[site]\"; missing: " \
@@ -114,7 +102,7 @@ def server(built):
 def browser(built):
     from playwright.sync_api import sync_playwright
     with sync_playwright() as pw:
-        chromium = pw.chromium.launch(executable_path=_chromium(), args=CHROMIUM_ARGS, headless=True)
+        chromium = pw.chromium.launch(executable_path=lab_harness.chromium_path(), args=lab_harness.CHROMIUM_ARGS, headless=True)
         yield chromium
         chromium.close()
 

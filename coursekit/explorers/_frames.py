@@ -205,12 +205,10 @@ class FrameRenderer:
         return {unit for unit in self._units() if _is_stale(unit)}
 
     def _layout_key(self):
-        """Everything the background depends on, besides the artists that are redrawn."""
-        axes = tuple((ax.get_position().bounds, ax.get_xlim(), ax.get_ylim(), ax.get_xscale(),
-                      ax.get_yscale(), ax.get_xlabel(), ax.get_ylabel(), ax.get_visible())
-                     for ax in self.fig.axes)
-        texts = tuple(sorted((id(a), a.get_text().count("\n")) for a in self._moving if hasattr(a, "get_text")))
-        return (tuple(self.fig.get_size_inches()), self.fig.dpi, axes, texts)
+        """Everything the background depends on, besides the artists that are redrawn: what the
+        layout depends on (`_layout_state`), the places of the axes and the resolution."""
+        places = tuple(ax.get_position().bounds for ax in self.fig.axes)
+        return self.fig.dpi, places, self._layout_state()
 
     # --- drawing -----------------------------------------------------------------------------
 
