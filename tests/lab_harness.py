@@ -177,27 +177,46 @@ _ERRORS_JS = f"""() => Array.from(document.querySelectorAll('{ACTIVE} .jp-Output
                  || o.dataset.mimeType === 'application/vnd.jupyter.stderr')
     .map(o => o.textContent.slice(0, 1500))"""
 
-# every error and stderr message of the kernel, also those of widget callbacks, which
-# JupyterLab shows in no cell
-_WATCH_KERNEL_JS = """() => {
-    const kernel = window.jupyterapp.shell.currentWidget.sessionContext.session.kernel;
-    window.__ckKernelErrors = [];
-    kernel.iopubMessage.connect((_, msg) => {
+# Opens a notebook and records every error and stderr message of its kernel from the start,
+# also those of widget callbacks, which JupyterLab shows in no cell. One exchange is harmless and
+# left out (see `error_outputs`): JupyterLab's widget manager asks a newly started kernel for its
+# widgets over a 'jupyter.widget.control' comm; a kernel that has not imported ipywidgets yet
+# logs that it has no such comm target, closes the comm, and logs "No such comm: <id>" for each
+# message the manager sends over it before it learns of the close (the lines may come in either
+# order, so they are told apart by the comm's id). The manager then asks another
+# way; the ipywidgets maintainers call these lines harmless (ipywidgets issue 3525). Whether they
+# come depends on how soon the manager asks, so they cannot be relied on either way.
+_OPEN_AND_WATCH_JS = """async name => {
+    const widget = await window.jupyterapp.commands.execute(
+        'docmanager:open', {path: name, factory: 'Notebook'});
+    const watch = {stderr: [], errors: [], controlComms: []};
+    window.__ckKernelWatch = watch;
+    const context = widget.sessionContext;
+    context.iopubMessage.connect((_, msg) => {
         const c = msg.content;
         if (msg.header.msg_type === 'error') {
-            window.__ckKernelErrors.push(`${c.ename}: ${c.evalue}`);
+            watch.errors.push(`${c.ename}: ${c.evalue}`);
         } else if (msg.header.msg_type === 'stream' && c.name === 'stderr') {
-            window.__ckKernelErrors.push(c.text);
+            watch.stderr.push(c.text);
         }
     });
+    const watchSent = kernel => kernel?.anyMessage.connect((_, {msg, direction}) => {
+        if (direction === 'send' && msg.header.msg_type === 'comm_open'
+                && msg.content.target_name === 'jupyter.widget.control') {
+            watch.controlComms.push(msg.content.comm_id);
+        }
+    });
+    watchSent(context.session?.kernel);
+    context.kernelChanged.connect((_, change) => watchSent(change.newValue));
 }"""
+
+_HARMLESS_STDERR = re.compile(r"No such comm target registered: jupyter\.widget\.control|No such comm: (\S+)")
 
 
 def open_notebook(page, name: str) -> None:
-    """Open `name` in the already loaded JupyterLab (no page reload), wait for its kernel and
-    start recording the kernel's error output (see `error_outputs`)."""
-    page.evaluate("name => window.jupyterapp.commands.execute('docmanager:open', "
-                  "{path: name, factory: 'Notebook'})", name)
+    """Open `name` in the already loaded JupyterLab (no page reload), start recording its
+    kernel's error output (see `error_outputs`) and wait until the kernel is idle."""
+    page.evaluate(_OPEN_AND_WATCH_JS, name)
     page.wait_for_function("name => Array.from(window.jupyterapp.shell.widgets('main'))"
                            ".some(w => w.context?.path === name && w.isVisible)",
                            arg=name, timeout=60_000)
@@ -209,14 +228,25 @@ def open_notebook(page, name: str) -> None:
                            ".some(w => w.context?.path === name"
                            " && w.sessionContext?.session?.kernel?.status === 'idle')",
                            arg=name, timeout=90_000)
-    page.evaluate(_WATCH_KERNEL_JS)
 
 
 def error_outputs(page) -> list[str]:
     """Tracebacks and stderr in the active notebook's outputs, error and stderr messages of its
-    kernel (widget callbacks included), and uncaught errors in the page."""
-    return (page.evaluate(_ERRORS_JS) + page.evaluate("() => window.__ckKernelErrors || []")
+    kernel (widget callbacks included; not the widget manager's refused control comm, see
+    `_OPEN_AND_WATCH_JS`), and uncaught errors in the page."""
+    watch = page.evaluate("() => window.__ckKernelWatch") or {"stderr": [], "errors": [], "controlComms": []}
+    return (page.evaluate(_ERRORS_JS) + watch["errors"]
+            + [text for text in watch["stderr"] if not _harmless(text, set(watch["controlComms"]))]
             + list(page.ck_page_errors))
+
+
+def _harmless(stderr: str, control_comms: set[str]) -> bool:
+    """True when every line of `stderr` is the kernel refusing a widget control comm."""
+    for line in filter(None, (line.strip() for line in stderr.splitlines())):
+        match = _HARMLESS_STDERR.fullmatch(line)
+        if match is None or (match[1] is not None and match[1] not in control_comms):
+            return False
+    return True
 
 
 def run_all(page) -> None:

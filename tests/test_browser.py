@@ -218,6 +218,27 @@ def _check_drag(page, name: str, factory: str, shown: str) -> None:
     assert not errors, f"{name}: an error was reported during the drag:\n" + "\n----\n".join(errors)
 
 
+# what JupyterLab's widget manager sends a kernel that has not imported ipywidgets when it
+# looks for existing widgets: a comm to the control target, then a request over that comm
+_CONTROL_PROBE_JS = """async () => {
+    const kernel = window.jupyterapp.shell.currentWidget.sessionContext.session.kernel;
+    const comm = kernel.createComm('jupyter.widget.control');
+    const opened = comm.open({}).done;
+    const sent = comm.send({method: 'request_states'}).done;
+    await Promise.all([opened, sent]);
+}"""
+
+
+def test_kernel_errors_are_reported_but_not_the_widget_managers_control_probe(page, opened):
+    with opened("demo_explorer.ipynb"):
+        page.evaluate(_CONTROL_PROBE_JS)
+        printed = lab_h.execute_in_kernel(page, "import sys; print('stderr from the kernel', file=sys.stderr)")
+        page.wait_for_timeout(500)
+        errors = lab_h.error_outputs(page)
+    assert printed.strip() == "stderr from the kernel"
+    assert errors == ["stderr from the kernel\n"], errors
+
+
 def _readout_value(page) -> float:
     """The value the first slider's readout shows (its minus sign may be U+2212)."""
     text = lab_h.first_slider(page).locator(".widget-readout").inner_text()
