@@ -218,6 +218,36 @@ def _check_drag(page, name: str, factory: str, shown: str) -> None:
     assert not errors, f"{name}: an error was reported during the drag:\n" + "\n----\n".join(errors)
 
 
+def test_a_step_to_a_position_held_ahead_shows_its_frame_at_once(page, opened):
+    """While the explorer is on screen the browser holds the frames of the next slider
+    positions; a key step to one shows that frame (no wait for the kernel), and it is the
+    kernel's figure for the value the slider shows."""
+    name, (_, factory, shown) = "msd_explorer.ipynb", DRAG_NOTEBOOKS["msd_explorer.ipynb"]
+    with opened(name):
+        _run_without_errors(page, name)
+        view = page.locator(f"{lab_h.ACTIVE} .ck-explorer .ck-figure-view").first
+        page.wait_for_function("v => Number(v.dataset.held || 0) >= 5", arg=view.element_handle(),
+                               timeout=SLIDER_TIMEOUT_S * 1000)
+        start = _readout_value(page)
+        handle = lab_h.first_slider(page).locator(".noUi-handle").first
+        handle.focus()
+        lab_h.install_probe(page)
+        handle.press("ArrowRight")
+        page.wait_for_function("v => v.querySelector('img').dataset.frame === 'ahead'",
+                               arg=view.element_handle(), timeout=5000)
+        lab_h.wait_until_quiet(page, quiet_ms=1000, timeout=SLIDER_TIMEOUT_S)
+        assert _readout_value(page) != start
+        assert view.locator("img").get_attribute("data-frame") == "ahead"
+        reference = json.loads(lab_h.execute_in_kernel(page, _REFERENCE_CODE.format(factory=factory, shown=shown)))
+        assert list(reference["params"].values())[0] == pytest.approx(_readout_value(page), rel=1e-3)
+        shown_px = _pixels(base64.b64decode(page.evaluate(_SHOWN_PNG_JS)))
+        expected_px = _pixels(base64.b64decode(reference["png"]))
+        assert shown_px.shape == expected_px.shape
+        assert np.count_nonzero(np.any(shown_px != expected_px, axis=-1)) == 0
+        errors = lab_h.error_outputs(page)
+        assert not errors, "\n----\n".join(errors)
+
+
 # what JupyterLab's widget manager sends a kernel that has not imported ipywidgets when it
 # looks for existing widgets: a comm to the control target, then a request over that comm
 _CONTROL_PROBE_JS = """async () => {

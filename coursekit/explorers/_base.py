@@ -15,6 +15,13 @@ drawn by a `FrameRenderer`: the axes, ticks and labels are drawn once and
 reused while only curves and titles move, so a frame costs a few tens of
 milliseconds instead of a full draw.
 
+While an explorer is on screen, the browser also asks the kernel, one at a
+time, for the frames of the slider positions next to the current ones (nearest
+first, the slider under the pointer first) and keeps them; a slider moved to a
+position it holds shows that frame at once, without waiting for the kernel.
+The kernel draws such a frame without touching the controls or what is shown
+(`Explorer.frame_for`).
+
 The figure is rendered at the pixel size it is shown with: the view reports
 the screen's device pixel ratio and the room available (the output width, and
 the visible height less the explorer's controls), and the figure is scaled
@@ -34,6 +41,8 @@ import base64
 from collections import OrderedDict
 from typing import Any, Callable
 
+import numpy as np
+
 from ._frames import FrameRenderer, encode_png
 
 __all__ = ["Explorer", "slider", "int_slider", "dropdown", "figure_png", "rescale"]
@@ -46,6 +55,10 @@ LECTURE_MAX_SCALE = 2.0
 
 #: how many recent frames an explorer keeps, for settings shown again
 FRAME_CACHE_SIZE = 128
+
+#: significant digits of a slider value in a frame's key: the browser's slider and its
+#: frames-ahead requests may reach the same position by different float roundings
+KEY_DIGITS = 12
 
 
 def _control_layout():
@@ -92,6 +105,44 @@ def figure_png(fig) -> bytes:
     return encode_png(canvas.buffer_rgba(), fig.dpi)
 
 
+def _is_slider(widget) -> bool:
+    """A FloatSlider or IntSlider (the controls the browser steps through ahead of the hand)."""
+    import ipywidgets as widgets
+    return isinstance(widget, (widgets.FloatSlider, widgets.IntSlider))
+
+
+def view_values(controls: dict[str, Any]) -> dict[str, Any]:
+    """The controls' settings as the browser sees them: a slider's value, a choice's index."""
+    return {name: w.index if hasattr(w, "index") else w.value for name, w in controls.items()}
+
+
+def requested_params(controls: dict[str, Any], values) -> dict[str, Any] | None:
+    """The parameters for settings `values` the browser asks a frame for, or None when they do
+    not fit: every control named, each slider at a finite number within its range (a whole one
+    for an IntSlider), every other control at its current setting."""
+    if not isinstance(values, dict) or set(values) != set(controls):
+        return None
+    shown = view_values(controls)
+    params = {}
+    for name, w in controls.items():
+        value = values[name]
+        if not _is_slider(w):
+            if value != shown[name]:
+                return None
+            params[name] = w.value
+            continue
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
+            return None
+        if not w.min - 1e-9 * abs(w.step) <= value <= w.max + 1e-9 * abs(w.step):
+            return None
+        if isinstance(w.value, int):
+            if value != int(value):
+                return None
+            value = int(value)
+        params[name] = float(value) if isinstance(w.value, float) else value
+    return params
+
+
 def _fit_scale(natural_px, screen: dict, largest: float = 1.0) -> float:
     """The factor (at most `largest`) by which a figure of `natural_px` (width, height) fits the
     reported room."""
@@ -124,7 +175,17 @@ class Explorer:
         per inch by default); default from matplotlib's settings. The figure
         is shown smaller when the screen has less room; in lecture mode it
         also grows (up to `LECTURE_MAX_SCALE` times) to fill the room.
+
+    Attributes
+    ----------
+    frames_ahead : bool
+        Class-wide switch, read when the widget is built: whether the browser asks for the
+        frames of the slider positions next to the current settings while the explorer is on
+        screen (default True). Set ``Explorer.frames_ahead = False`` where the kernel's CPU is
+        scarce; every update is then a round trip to the kernel.
     """
+
+    frames_ahead: bool = True
 
     def __init__(self, *, title: str, controls: dict[str, Any], compute: Callable[..., Any],
                  draw: Callable[[Any], Any], update: Callable[[Any, Any], None], figsize=None):
@@ -149,7 +210,7 @@ class Explorer:
         self._update(self.handles, self.result)
         self._cache: OrderedDict = OrderedDict()
         self._png = self.frames.frame()
-        self._remember()
+        self._remember(self._frame_key(self.params), self.result, self._png)
         self._widget = None
         self._view = None
 
@@ -171,7 +232,7 @@ class Explorer:
         and drawn again; the figure's artists are still updated, so they always match what is
         shown.
         """
-        key = self._frame_key()
+        key = self._frame_key(self.params)
         cached = self._cache.get(key)
         if cached is not None:
             self._cache.move_to_end(key)
@@ -183,16 +244,37 @@ class Explorer:
         self._update(self.handles, self.result)
         self._show()
 
+    def frame_for(self, params: dict[str, Any]) -> bytes:
+        """The frame (PNG bytes) for the settings `params`, from the cache or computed and
+        drawn, without changing the controls or the frame shown.
+
+        What the browser asks for ahead of the hand. The figure's artists are put back to the
+        settings shown afterwards, so the next frame or `static_png` draws those.
+        """
+        key = self._frame_key(params)
+        cached = self._cache.get(key)
+        if cached is not None:
+            return cached[1]
+        result = self._compute(**params)
+        self._update(self.handles, result)
+        png = self.frames.frame()
+        self._remember(key, result, png)
+        self._update(self.handles, self.result)
+        return png
+
     def forget_frames(self) -> None:
         """Forget the remembered frames, so that the next `refresh` computes and draws anew
         (what a benchmark of the redraw times)."""
         self._cache.clear()
 
-    def _frame_key(self):
-        return tuple(self.params.items()), self.fig.dpi
+    def _frame_key(self, params: dict[str, Any]):
+        values = tuple((name, float(f"{value:.{KEY_DIGITS}g}") if isinstance(value, float) else value)
+                       for name, value in params.items())
+        return values, self.fig.dpi
 
-    def _remember(self) -> None:
-        self._cache[self._frame_key()] = (self.result, self._png)
+    def _remember(self, key, result, png: bytes) -> None:
+        self._cache[key] = (result, png)
+        self._cache.move_to_end(key)
         while len(self._cache) > FRAME_CACHE_SIZE:
             self._cache.popitem(last=False)
 
@@ -210,7 +292,7 @@ class Explorer:
     def _show(self) -> None:
         """Draw a frame of the figure as it is now, remember it and send it to the view."""
         self._png = self.frames.frame()
-        self._remember()
+        self._remember(self._frame_key(self.params), self.result, self._png)
         self._send()
 
     def _send(self) -> None:
@@ -219,6 +301,7 @@ class Explorer:
             height, width = self.frames.canvas.buffer_rgba().shape[:2]
             with self._view.hold_sync():
                 self._view.png = self._png
+                self._view.values = view_values(self.controls)
                 self._view.css_width = width / ratio
                 self._view.css_height = height / ratio
                 self._view.alt = self._alt_text()
@@ -236,7 +319,31 @@ class Explorer:
         if abs(dpi - self.fig.dpi) > 1e-6:
             self.fig.set_dpi(dpi)
             self.forget_frames()         # frames at the old resolution are not shown again
+            if self._view is not None:
+                self._view.generation += 1   # nor those the browser holds
         self._show()
+
+    def _on_view_msg(self, view, content, buffers) -> None:
+        """Answer the browser's request for a frame ahead of the hand: ``{"type": "frame",
+        "values": ..., "generation": n, "view": id}`` gets the frame (PNG as the message's
+        buffer; values, generation and the asking view's id sent back), or a
+        ``"no-frame"`` reply when the request does not fit the controls or the settings cannot
+        be computed (the browser then asks for other settings; moving a slider there shows the
+        error as usual)."""
+        if not isinstance(content, dict) or content.get("type") != "frame":
+            return
+        reply = {"type": "no-frame", **{key: content.get(key) for key in ("values", "generation", "view")}}
+        params = requested_params(self.controls, content.get("values"))
+        if params is None or content.get("generation") != view.generation:
+            view.send(reply)
+            return
+        try:
+            png = self.frame_for(params)
+        except Exception:   # noqa: BLE001 - the user meets the error when moving there
+            self._update(self.handles, self.result)
+            view.send(reply)
+            return
+        view.send({**reply, "type": "frame"}, [png])
 
     def _settings(self) -> str:
         return ", ".join(f"{k}={v:g}" if isinstance(v, (int, float)) else f"{k}={v!r}"
@@ -252,10 +359,12 @@ class Explorer:
             import ipywidgets as widgets
 
             from ._view import FigureView
-            self._view = FigureView(png=self._png, alt=self._alt_text(),
+            self._view = FigureView(png=self._png, alt=self._alt_text(), controls=self.controls,
+                                    values=view_values(self.controls), ahead=bool(self.frames_ahead),
                                     css_width=float(self.frames.canvas.buffer_rgba().shape[1]),
                                     css_height=float(self.frames.canvas.buffer_rgba().shape[0]))
             self._view.observe(self._on_screen, names="screen")
+            self._view.on_msg(self._on_view_msg)
             for w in self.controls.values():
                 w.observe(self._on_change, names="value")
             header = widgets.HTML(f"<b>{self.title}</b>")
