@@ -83,3 +83,18 @@ def test_integral_action_responses_are_linear_in_d_and_the_axes_hold_the_largest
     e.refresh()
     assert e.handles["ax_y"].get_ylim() == limits       # a smaller d draws a smaller response
     assert limits[1] >= ch3.INTEGRAL_D_MAX * e.result["y_per_d"]
+
+
+def test_the_pendulum_started_upright_is_drawn_flat_not_its_numerical_noise():
+    e = ch3.upright_pendulum_explorer()
+    e.controls["theta0_deg"].value = 0.0
+    e.refresh()
+    assert 0 < np.abs(e.result["dev_linear"]).max() < 1e-6        # the integrator's noise only
+    low, high = e.handles["ax_th"].get_ylim()
+    assert high - low >= 2.0 and low < 0 < high
+    low, high = e.handles["ax_u"].get_ylim()
+    assert high - low >= 0.2
+    e.controls["theta0_deg"].value = 30.0                         # a real response keeps its scale
+    e.refresh()
+    low, high = e.handles["ax_th"].get_ylim()
+    assert low <= -30.0 and high - low < 60.0 + 30.0

@@ -90,10 +90,20 @@ def dropdown(options, value, description: str):
                             style={"description_width": "initial"}, layout=_control_layout())
 
 
-def rescale(*axes) -> None:
-    """Fit each axes' view to the data its artists hold now (after ``set_data`` in an update)."""
+def rescale(*axes, min_span: float = 0.0) -> None:
+    """Fit each axes' view to the data its artists hold now (after ``set_data`` in an update).
+
+    With `min_span`, the vertical view spans at least that much, centred on the data: a
+    response that stays at a constant (a pendulum started upright) is drawn flat instead of
+    its numerical noise, a millionth of a unit, filling the axes.
+    """
     for ax in axes:
         ax.relim()
+        low, high = ax.dataLim.intervaly
+        if np.isfinite(low) and np.isfinite(high) and high - low < min_span:
+            # widen the data limits, not the view: the axes stays autoscaled (and snapped)
+            middle, x = (low + high) / 2, ax.dataLim.x0
+            ax.update_datalim([(x, middle - min_span / 2), (x, middle + min_span / 2)])
         ax.autoscale_view()
 
 

@@ -203,7 +203,8 @@ def upright_pendulum_explorer() -> Explorer:
         h["fl"].set_data(r["t"], r["dev_fl"])
         h["ulin"].set_data(r["t"], r["u_linear"])
         h["ufl"].set_data(r["t"], r["u_fl"])
-        rescale(h["ax_th"], h["ax_u"])
+        rescale(h["ax_th"], min_span=2.0)     # degrees: started upright, it stays there
+        rescale(h["ax_u"], min_span=0.2)      # N m
         verdict = lambda ok: "upright" if ok else "NOT upright"  # noqa: E731
         h["ax_th"].set_title(f"start {r['theta0_deg']:g} deg from upright, |u| <= {r['u_max']:g} N m\n"
                              f"linear: {verdict(r['linear_ok'])}, feedback linearizing: {verdict(r['fl_ok'])}")
