@@ -259,14 +259,18 @@ function render({ model, el }) {
     if (index >= 0 && index < controls.length) focus = controls[index].name;
   }
 
+  let removed = false;
+  const onControl = () => { display(); ask(); };
+  const onAlt = () => { img.alt = model.get("alt"); };
   model.on("change:png", fromKernel);
-  model.on("change:alt", () => { img.alt = model.get("alt"); });
+  model.on("change:alt", onAlt);
   model.on("change:generation", newGeneration);
   model.on("msg:custom", onReply);
   fromKernel();
   controlModels(model).then(found => {
+    if (removed) return;
     controls = found;
-    for (const { model: m } of controls) m.on("change:value change:index", () => { display(); ask(); });
+    for (const { model: m } of controls) m.on("change:value change:index", onControl);
     display();
     ask();
   }).catch(() => { controls = null; });   // without the controls, the kernel's frames only
@@ -283,7 +287,14 @@ function render({ model, el }) {
   window.addEventListener("resize", schedule);
   document.addEventListener("visibilitychange", ask);
   schedule();
-  return () => {
+  return () => {   // the view is removed (its output cleared): it holds, shows and asks nothing more
+    removed = true;
+    visible = false;
+    model.off("change:png", fromKernel);
+    model.off("change:alt", onAlt);
+    model.off("change:generation", newGeneration);
+    model.off("msg:custom", onReply);
+    for (const { model: m } of controls || []) m.off("change:value change:index", onControl);
     seen.disconnect();
     resized.disconnect();
     window.removeEventListener("resize", schedule);
