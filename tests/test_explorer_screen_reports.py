@@ -1,0 +1,50 @@
+"""A screen report (the browser's room for the figure and its pixel ratio) changes only the
+resolution of an explorer's figure: the view limits, and so what the figure shows, stay those of
+the settings shown. Window resizes send such reports; the figure after a resize and back must be
+the figure before it."""
+
+import io
+
+import numpy as np
+import pytest
+
+from coursekit.explorers import ch1, ch2, ch3, ch4
+
+FACTORIES = [ch1.euler_explorer, ch1.msd_explorer, ch2.planner_explorer, ch3.pole_placement_explorer,
+             ch3.upright_pendulum_explorer, ch3.integral_action_explorer, ch4.observer_noise_explorer,
+             ch4.kalman_tuning_explorer]
+
+WIDE = {"width": 1500, "height": 900, "ratio": 1}      # room for the natural size: the dpi stays
+NARROW = {"width": 650, "height": 900, "ratio": 1}     # a narrower window: the figure shrinks
+
+
+def _pixels(png: bytes) -> np.ndarray:
+    from matplotlib.image import imread
+    return imread(io.BytesIO(png), format="png")
+
+
+def _limits(explorer):
+    return [tuple(round(float(v), 6) for v in (*ax.get_xlim(), *ax.get_ylim())) for ax in explorer.fig.axes]
+
+
+@pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
+def test_screen_reports_without_a_new_setting_leave_the_view_limits(factory):
+    explorer = factory()
+    explorer._on_screen({"new": WIDE})
+    before = _limits(explorer)
+    for screen in (NARROW, WIDE, NARROW, WIDE):
+        explorer._on_screen({"new": screen})
+    assert _limits(explorer) == before, (
+        f"{factory.__name__}: after a resize and back the view limits went from {before} to "
+        f"{_limits(explorer)} (the settings did not change)")
+
+
+@pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
+def test_a_repeated_screen_report_sends_the_same_figure(factory):
+    explorer = factory()
+    explorer._on_screen({"new": WIDE})
+    first = explorer.png
+    explorer._on_screen({"new": dict(WIDE, height=WIDE["height"] - 50)})   # same dpi, new report
+    assert np.array_equal(_pixels(explorer.png), _pixels(first)), (
+        f"{factory.__name__}: a second screen report at the same resolution changed the figure "
+        f"of unchanged settings (view limits now {_limits(explorer)})")
