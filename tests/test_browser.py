@@ -311,3 +311,85 @@ def _count_code_cells(name: str) -> int:
         return len(DEMO_SOURCE)
     cells = json.loads((NOTEBOOKS / name).read_text(encoding="utf-8"))["cells"]
     return sum(cell["cell_type"] == "code" for cell in cells)
+
+
+# run in the notebook's kernel: note every drawing of a matplotlib figure (an explorer's frame,
+# a full Agg draw, a PNG written) with the thread it runs on, and every time two of them run at
+# once on different threads (matplotlib's figures and its font cache are not thread-safe)
+_DRAW_WATCH_CODE = """\
+import functools as _functools
+import threading as _threading
+from matplotlib.backends.backend_agg import FigureCanvasAgg as _Agg
+from coursekit.explorers import _frames as _ck_frames_module
+_ck_watch = {"active": [], "overlaps": [], "threads": set()}
+_ck_watch_lock = _threading.Lock()
+def _ck_watched(original):
+    @_functools.wraps(original)
+    def watched(*args, **kwargs):
+        me = _threading.current_thread().name
+        with _ck_watch_lock:
+            others = sorted({name for name in _ck_watch["active"] if name != me})
+            if others:
+                _ck_watch["overlaps"].append(f"{original.__qualname__} on {me} while {others} drew")
+            _ck_watch["active"].append(me)
+            _ck_watch["threads"].add(me)
+        try:
+            return original(*args, **kwargs)
+        finally:
+            with _ck_watch_lock:
+                _ck_watch["active"].remove(me)
+    return watched
+_Agg.draw = _ck_watched(_Agg.draw)
+_Agg.print_png = _ck_watched(_Agg.print_png)
+_ck_frames_module.FrameRenderer.frame = _ck_watched(_ck_frames_module.FrameRenderer.frame)
+"""
+
+# a cell a student runs while the explorer is on screen: it draws a figure of its own
+_PLOT_CELL_CODE = """\
+import io as _io
+import matplotlib.pyplot as _plt
+for _i in range(15):
+    _fig, _ax = _plt.subplots()
+    _ax.plot(range(50), [(_i * _k) % 7 for _k in range(50)])
+    _ax.set(title=f"figure {_i}", xlabel="k", ylabel="value")
+    _fig.savefig(_io.BytesIO(), format="png")
+    _plt.close(_fig)
+print("plotted")
+"""
+
+
+def test_frames_ahead_never_draw_at_the_same_time_as_other_kernel_work(page, opened):
+    """While the browser asks for frames ahead, the kernel draws them; a dropdown changed meanwhile
+    and a cell run meanwhile draw too. matplotlib is not thread-safe (figures, and the font cache
+    that every figure shares), so those drawings must never overlap, whichever thread or kernel
+    subshell each message is handled on; and once settled, the figure shown is the kernel's
+    figure for the settings shown."""
+    name, (_, factory, shown) = "msd_explorer.ipynb", DRAG_NOTEBOOKS["msd_explorer.ipynb"]
+    with opened(name):
+        _run_without_errors(page, name)
+        lab_h.execute_in_kernel(page, _DRAW_WATCH_CODE)
+        view = page.locator(f"{lab_h.ACTIVE} .ck-explorer .ck-figure-view").first
+        page.wait_for_function("v => Number(v.dataset.held || 0) >= 5", arg=view.element_handle(),
+                               timeout=SLIDER_TIMEOUT_S * 1000)
+        choice = page.locator(f"{lab_h.ACTIVE} .ck-explorer .widget-dropdown select").first
+        for option in ["initial", "step", "initial", "step", "initial"]:
+            choice.select_option(option)
+            page.wait_for_timeout(400)
+        assert lab_h.execute_in_kernel(page, _PLOT_CELL_CODE).strip() == "plotted"
+        lab_h.install_probe(page)
+        lab_h.wait_until_quiet(page, quiet_ms=1500, timeout=SLIDER_TIMEOUT_S)
+        watch = json.loads(lab_h.execute_in_kernel(
+            page, "import json; print(json.dumps({k: sorted(v) if isinstance(v, set) else v"
+                  " for k, v in _ck_watch.items()}))"))
+        assert not watch["overlaps"], (
+            f"{name}: figures were drawn at the same time on different threads "
+            f"{watch['threads']} ({len(watch['overlaps'])} times), e.g. {watch['overlaps'][:3]}")
+        reference = json.loads(lab_h.execute_in_kernel(page, _REFERENCE_CODE.format(factory=factory, shown=shown)))
+        assert reference["params"]["experiment"] == "initial"
+        shown_px = _pixels(base64.b64decode(page.evaluate(_SHOWN_PNG_JS)))
+        expected_px = _pixels(base64.b64decode(reference["png"]))
+        assert shown_px.shape == expected_px.shape
+        differ = np.count_nonzero(np.any(shown_px != expected_px, axis=-1))
+        assert differ == 0, f"{name}: the figure shown is not the one for {reference['params']} ({differ} pixels differ)"
+        errors = lab_h.error_outputs(page)
+        assert not errors, "\n----\n".join(errors)
