@@ -48,3 +48,14 @@ def test_a_repeated_screen_report_sends_the_same_figure(factory):
     assert np.array_equal(_pixels(explorer.png), _pixels(first)), (
         f"{factory.__name__}: a second screen report at the same resolution changed the figure "
         f"of unchanged settings (view limits now {_limits(explorer)})")
+
+
+def test_the_robot_planner_keeps_the_start_of_the_path_in_view_after_screen_reports():
+    explorer = ch2.robot_planner_explorer()
+    ax = explorer.fig.axes[0]
+    for screen in (WIDE, dict(WIDE, height=WIDE["height"] - 20), NARROW, WIDE):
+        explorer._on_screen({"new": screen})
+        (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+        assert x0 <= 0.0 <= x1 and y0 <= 0.0 <= y1, (
+            f"after the screen report {screen} the path's start (0, 0) is outside the view "
+            f"x {x0:.2f}..{x1:.2f}, y {y0:.2f}..{y1:.2f}")
