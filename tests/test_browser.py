@@ -104,6 +104,7 @@ def lab(tmp_path_factory):
         shutil.copy(NOTEBOOKS / name, root / name)
     for name, (cells, _, _) in DRAG_NOTEBOOKS.items():
         lab_h.write_notebook(root / name, cells)
+    lab_h.write_notebook(root / PLOTS_BESIDE_EXPLORER, [*DRAG_NOTEBOOKS["msd_explorer.ipynb"][0], _PLOT_CELL_CODE])
     with lab_h.running_lab(root, base) as url:
         yield url
 
@@ -344,7 +345,8 @@ _Agg.print_png = _ck_watched(_Agg.print_png)
 _ck_frames_module.FrameRenderer.frame = _ck_watched(_ck_frames_module.FrameRenderer.frame)
 """
 
-# a cell a student runs while the explorer is on screen: it draws a figure of its own
+# a cell a student runs while the explorer is on screen: it draws figures of its own
+PLOTS_BESIDE_EXPLORER = "plots_beside_explorer.ipynb"
 _PLOT_CELL_CODE = """\
 import io as _io
 import matplotlib.pyplot as _plt
@@ -362,9 +364,11 @@ def test_frames_ahead_never_draw_at_the_same_time_as_other_kernel_work(page, ope
     """While the browser asks for frames ahead, the kernel draws them; a dropdown changed meanwhile
     and a cell run meanwhile draw too. matplotlib is not thread-safe (figures, and the font cache
     that every figure shares), so those drawings must never overlap, whichever thread or kernel
-    subshell each message is handled on; and once settled, the figure shown is the kernel's
-    figure for the settings shown."""
-    name, (_, factory, shown) = "msd_explorer.ipynb", DRAG_NOTEBOOKS["msd_explorer.ipynb"]
+    subshell each message is handled on (the explorer handles every message on the kernel's main
+    thread, and the browser asks for no frame while a cell runs: each widget message makes the
+    kernel flush the running cell's figures on the thread the message arrives on); and once
+    settled, the figure shown is the kernel's figure for the settings shown."""
+    name, (_, factory, shown) = PLOTS_BESIDE_EXPLORER, DRAG_NOTEBOOKS["msd_explorer.ipynb"]
     with opened(name):
         _run_without_errors(page, name)
         lab_h.execute_in_kernel(page, _DRAW_WATCH_CODE)
@@ -375,7 +379,12 @@ def test_frames_ahead_never_draw_at_the_same_time_as_other_kernel_work(page, ope
         for option in ["initial", "step", "initial", "step", "initial"]:
             choice.select_option(option)
             page.wait_for_timeout(400)
-        assert lab_h.execute_in_kernel(page, _PLOT_CELL_CODE).strip() == "plotted"
+        # the plotting cell again, while the browser is asking for the new setting's frames
+        page.evaluate("() => { const panel = window.jupyterapp.shell.currentWidget;"
+                      " panel.content.activeCellIndex = panel.content.widgets.length - 1;"
+                      " return window.jupyterapp.commands.execute('notebook:run-cell'); }")
+        prompts = lab_h.wait_until_done(page, RUN_TIMEOUT_S)
+        assert prompts[-1] == f"[{len(prompts) + 1}]:", prompts     # the third cell ran again
         lab_h.install_probe(page)
         lab_h.wait_until_quiet(page, quiet_ms=1500, timeout=SLIDER_TIMEOUT_S)
         watch = json.loads(lab_h.execute_in_kernel(

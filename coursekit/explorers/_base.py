@@ -44,6 +44,7 @@ from typing import Any, Callable
 import numpy as np
 
 from ._frames import FrameRenderer, encode_png
+from ._home import HomeThread
 
 __all__ = ["Explorer", "slider", "int_slider", "dropdown", "figure_png", "rescale"]
 
@@ -316,8 +317,8 @@ class Explorer:
                 self._view.css_height = height / ratio
                 self._view.alt = self._alt_text()
 
-    def _on_change(self, change) -> None:
-        self.refresh()
+    def _on_latest_screen(self) -> None:
+        self._on_screen({"new": self._view.screen})
 
     def _on_screen(self, change) -> None:
         """Render at the size the figure is shown with: scaled to fit, at the screen's pixel ratio."""
@@ -373,10 +374,12 @@ class Explorer:
                                     values=view_values(self.controls), ahead=bool(self.frames_ahead),
                                     css_width=float(self.frames.canvas.buffer_rgba().shape[1]),
                                     css_height=float(self.frames.canvas.buffer_rgba().shape[0]))
-            self._view.observe(self._on_screen, names="screen")
-            self._view.on_msg(self._on_view_msg)
+            # every callback on the kernel's main thread, whichever thread a message arrives on
+            home = HomeThread()
+            self._view.observe(lambda change: home.run(self._on_latest_screen, key="screen"), names="screen")
+            self._view.on_msg(lambda view, content, buffers: home.run(self._on_view_msg, view, content, buffers))
             for w in self.controls.values():
-                w.observe(self._on_change, names="value")
+                w.observe(lambda change: home.run(self.refresh, key="refresh"), names="value")
             header = widgets.HTML(f"<b>{self.title}</b>")
             header.add_class("ck-title")
             column = "270px" if self.lecture else "300px"

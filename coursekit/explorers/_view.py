@@ -41,6 +41,16 @@ function room(el) {
   return { width: Math.floor(width), height: Math.floor(visible - others - 16) };
 }
 
+// true while cells of the notebook showing `el` run or wait to run (JupyterLab and Notebook
+// show them as [*]): each widget message the kernel gets then makes it flush the running
+// cell's figures, on another thread where the front end uses kernel subshells
+function cellsRunning(el) {
+  const notebook = el.closest(".jp-Notebook");
+  if (!notebook) return false;
+  return Array.from(notebook.querySelectorAll(".jp-InputPrompt"))
+    .some(prompt => prompt.textContent.includes("*"));
+}
+
 // the controls' models, in order: [{name, model}]
 async function controlModels(model) {
   const refs = Object.entries(model.get("controls") || {});
@@ -208,8 +218,14 @@ function render({ model, el }) {
   }
 
   // ask the kernel for the next frame ahead of the hand: one request at a time, while on screen
+  // and no cell runs
+  let later = null;
   function ask() {
     if (asked || !controls || !visible || document.hidden || !model.get("ahead")) return;
+    if (cellsRunning(el)) {
+      if (later === null) later = setTimeout(() => { later = null; ask(); }, 500);
+      return;
+    }
     if (frames.bytes > 0.9 * FRAME_BYTES) frames.trim(nearby, 0.75 * FRAME_BYTES);
     if (frames.bytes > 0.9 * FRAME_BYTES) return;   // the frames near the settings fill the budget
     const values = nextSettings();
@@ -302,6 +318,7 @@ function render({ model, el }) {
     explorer?.removeEventListener("pointerover", pointAt);
     explorer?.removeEventListener("focusin", pointAt);
     if (asked) clearTimeout(asked.timer);
+    if (later !== null) clearTimeout(later);
     frames.clear(null, null);
   };
 }

@@ -1,0 +1,59 @@
+"""Widget callbacks run on the kernel's main thread, one at a time.
+
+A front end may hand widget messages to a kernel *subshell*, a second thread of
+the kernel (JupyterLab 4.6 does so by default with ipykernel 7: its setting
+``commsOverSubshells``). A slider moved, a frame asked for ahead of the hand or
+a screen report then reaches the explorer on that thread, while a cell, a
+dropdown change or another explorer draws on the main thread. matplotlib is not
+safe for that: figures and the font cache every figure shares get corrupted
+(garbled or half-drawn frames, "failed to load glyph" errors).
+
+`HomeThread` remembers the thread that built the widget and its running event
+loop (the kernel's main thread and loop, in a notebook cell) and runs each
+callback there: at once when it arrives on that thread, else queued on that
+loop, which runs it between cells. Where no event loop runs (plain Python, the
+tests) callbacks run where they arrive.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import threading
+import traceback
+from typing import Any, Callable, Hashable
+
+__all__ = ["HomeThread"]
+
+
+class HomeThread:
+    """Runs callbacks on the thread (and event loop) that created it."""
+
+    def __init__(self) -> None:
+        self.thread = threading.current_thread()
+        try:
+            self.loop = asyncio.get_running_loop()
+        except RuntimeError:
+            self.loop = None
+        self._queued: set = set()
+
+    def run(self, fn: Callable[..., Any], *args, key: Hashable | None = None) -> None:
+        """Call ``fn(*args)`` on the home thread: now when called there (or when no loop runs
+        there), else queued on its loop. With `key`, a call is not queued while another with the
+        same key waits (it would do the same work: a callback that reads the latest state when it
+        runs, such as a redraw for the sliders' current values)."""
+        if threading.current_thread() is self.thread or self.loop is None or self.loop.is_closed():
+            fn(*args)
+            return
+        if key is not None:
+            if key in self._queued:
+                return
+            self._queued.add(key)
+        self.loop.call_soon_threadsafe(self._call, fn, args, key)
+
+    def _call(self, fn: Callable[..., Any], args: tuple, key: Hashable | None) -> None:
+        # forgotten before the call: a change that comes while it runs queues the next call
+        self._queued.discard(key)
+        try:
+            fn(*args)
+        except Exception:   # noqa: BLE001 - as for any widget callback: reported, the kernel goes on
+            traceback.print_exc()
