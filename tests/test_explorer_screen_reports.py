@@ -59,3 +59,21 @@ def test_the_robot_planner_keeps_the_start_of_the_path_in_view_after_screen_repo
         assert x0 <= 0.0 <= x1 and y0 <= 0.0 <= y1, (
             f"after the screen report {screen} the path's start (0, 0) is outside the view "
             f"x {x0:.2f}..{x1:.2f}, y {y0:.2f}..{y1:.2f}")
+
+
+@pytest.mark.parametrize("target", [(4.0, 2.0, 90.0), (-6.0, 6.0, 90.0), (6.0, 0.5, 90.0), (0.0, -6.0, -90.0),
+                                    (-6.0, -6.0, 180.0), (6.0, 6.0, 0.0)])
+def test_the_robot_planners_view_holds_the_start_and_the_whole_target_arrow(target):
+    explorer = ch2.robot_planner_explorer()
+    controls = explorer.controls
+    controls["x_T"].value, controls["y_T"].value, controls["heading_deg"].value = target
+    explorer.refresh()
+    ax = explorer.fig.axes[0]
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    tx, ty, heading = target
+    length = (x1 - x0) / 12.0           # the quiver's arrow: a twelfth of the view's width
+    tip = (tx + length * np.cos(np.deg2rad(heading)), ty + length * np.sin(np.deg2rad(heading)))
+    for name, (x, y) in {"start": (0.0, 0.0), "target": (tx, ty), "arrow tip": tip}.items():
+        assert x0 <= x <= x1 and y0 <= y <= y1, (
+            f"target {target}: the {name} ({x:.2f}, {y:.2f}) is outside the view "
+            f"x {x0:.2f}..{x1:.2f}, y {y0:.2f}..{y1:.2f}")
