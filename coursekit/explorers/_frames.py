@@ -178,7 +178,10 @@ class FrameRenderer:
     def frame(self) -> bytes:
         """Snap the view limits, draw the figure (blitting if possible) and return its PNG."""
         for ax in self.fig.axes:
-            self._snapped[ax] = snap_limits(ax, done=self._snapped.get(ax))
+            # an axes with a fixed aspect ratio widens its limits itself to the box when drawn;
+            # limits snapped by hand there would be cut to the box instead, data and all
+            if ax.get_aspect() == "auto":
+                self._snapped[ax] = snap_limits(ax, done=self._snapped.get(ax))
         moving = self._changed_units()
         if (self._background is None or not moving <= self._moving or self._layout_key() != self._key
                 or self._fixed_aspect()):

@@ -161,6 +161,15 @@ def drive_robot(t, u, x0) -> np.ndarray:
     return np.column_stack([position, theta])
 
 
+def _arrow_tip(points, tx: float, ty: float, th: float) -> np.ndarray:
+    """Where the target-pose arrow ends, about: the quiver draws it a twelfth of the view's
+    width long, and with equal scales the view is at most about 1.5 times as wide as it is
+    high; so the data limits hold the arrow too."""
+    span = np.ptp(points, axis=0)
+    length = max(span[0], 1.5 * span[1], 1.0) / 10.0
+    return np.array([[tx + length * np.cos(th), ty + length * np.sin(th)]])
+
+
 def robot_planner_explorer() -> Explorer:
     """Sliders for the target pose: planned path (flatness) and the path the robot drives."""
     def draw(fig):
@@ -168,6 +177,8 @@ def robot_planner_explorer() -> Explorer:
         path, = ax.plot([], [], "k--", label="planned path F_d")
         driven, = ax.plot([], [], color="C0", alpha=0.8, label="driven (model 1.10)")
         goal = ax.quiver([0.0], [0.0], [1.0], [0.0], color="C3", scale=12, label="target pose", zorder=3)
+        # an unseen line along the arrow, so the legend's "best" place keeps clear of all of it
+        shaft, = ax.plot([], [], alpha=0.0, label="_arrow")
         ax.plot([0], [0], "ko")
         ax.set_xlabel("x1 [m]")
         ax.set_ylabel("x2 [m]")
@@ -181,7 +192,7 @@ def robot_planner_explorer() -> Explorer:
         ax_u.set_title("inputs psi_u (2.102)")
         ax_u.legend(loc="best", fontsize="small")
         ax_u.grid(True, alpha=0.4)
-        return dict(ax=ax, ax_u=ax_u, path=path, driven=driven, goal=goal, u1=u1, u2=u2)
+        return dict(ax=ax, ax_u=ax_u, path=path, driven=driven, goal=goal, shaft=shaft, u1=u1, u2=u2)
 
     def update(h, r):
         h["path"].set_data(r["path"][:, 0], r["path"][:, 1])
@@ -197,7 +208,10 @@ def robot_planner_explorer() -> Explorer:
         # in newer matplotlib counts the arrow at a place that moves with the view, so the view
         # would widen at every update
         h["ax"].ignore_existing_data_limits = True
-        h["ax"].update_datalim(np.vstack([r["path"][:, :2], r["driven"][:, :2], [[0.0, 0.0], [tx, ty]]]))
+        points = np.vstack([r["path"][:, :2], r["driven"][:, :2], [[0.0, 0.0], [tx, ty]]])
+        tip = _arrow_tip(points, tx, ty, th)
+        h["shaft"].set_data(np.linspace(tx, tip[0, 0], 20), np.linspace(ty, tip[0, 1], 20))
+        h["ax"].update_datalim(np.vstack([points, tip]))
         for ax in (h["ax"], h["ax_u"]):
             ax.autoscale_view()
         h["ax"].set_title(f"two-wheeled robot to ({tx:g} m, {ty:g} m, {np.rad2deg(th):g} deg) "
