@@ -250,3 +250,14 @@ def test_the_frame_cache_is_bounded_and_dropped_when_the_resolution_changes():
     assert len(e._cache) <= FRAME_CACHE_SIZE
     _shown(e, width=300, height=300, ratio=1.0)
     assert len(e._cache) == 1 and next(iter(e._cache))[1] == e.fig.dpi
+
+
+@pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
+def test_every_slider_starts_on_one_of_its_steps(factory):
+    # a browser's slider moves a value between steps to the nearest step, so an explorer would
+    # show other settings than its defaults as soon as it is displayed
+    for name, w in _sliders(factory()).items():
+        steps = (w.value - w.min) / w.step
+        assert abs(steps - round(steps)) < 1e-6, (
+            f"{factory.__name__}: slider {name} starts at {w.value}, between the steps "
+            f"{w.min} + k * {w.step}")

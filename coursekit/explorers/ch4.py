@@ -173,6 +173,15 @@ def kalman_tuning_compute(log10_q: float, log10_r: float, *, seed: int = 0, t_en
                 poles=np.linalg.eigvals(sys.A - L @ sys.C), rms=rms, rms_matched=rms_m, L_matched=L_m)
 
 
+def _log_slider(true_value: float, low: float, high: float, description: str, step: float = 0.25):
+    """A slider for log10 of a noise intensity, starting at the true one: its range, about
+    [low, high], is moved so that the true value is one of its steps (a browser's slider moves
+    a value between steps to the nearest one, and the figure would start at a wrong intensity)."""
+    start = float(np.log10(true_value))
+    below, above = np.floor((start - low) / step + 1e-9), np.floor((high - start) / step + 1e-9)
+    return slider(start, start - below * step, start + above * step, step, description)
+
+
 def kalman_tuning_explorer() -> Explorer:
     """Sliders for log10 Q and log10 R of a Kalman observer on the same noisy data."""
     def draw(fig):
@@ -187,6 +196,6 @@ def kalman_tuning_explorer() -> Explorer:
 
     return Explorer(
         title="Kalman filter tuning (4.87)-(4.88): only Q/R matters",
-        controls=dict(log10_q=slider(np.log10(KALMAN_TRUE_Q), -4.0, 3.0, 0.25, "log10 Q (velocity)"),
-                      log10_r=slider(np.log10(KALMAN_TRUE_R), -6.0, 0.0, 0.25, "log10 R (GPS)")),
+        controls=dict(log10_q=_log_slider(KALMAN_TRUE_Q, -4.0, 3.0, "log10 Q (velocity)"),
+                      log10_r=_log_slider(KALMAN_TRUE_R, -6.0, 0.0, "log10 R (GPS)")),
         compute=kalman_tuning_compute, draw=draw, update=update, figsize=(8, 6))
