@@ -214,14 +214,15 @@ class Explorer:
         self.natural_dpi = float(self.fig.dpi)
         self.handles = draw(self.fig)
         self.screen: dict = {}
-        self.result = self._compute(**self.params)
+        self._shown_values, self._shown_params = self._settings_now()
+        self.result = self._compute(**self._shown_params)
         # update, then watch the update repeated: the artists it touches are the ones that move
         self._update(self.handles, self.result)
         self.frames = FrameRenderer(self.fig)
         self._update(self.handles, self.result)
         self._cache: OrderedDict = OrderedDict()
         self._png = self.frames.frame()
-        self._remember(self._frame_key(self.params), self.result, self._png)
+        self._remember(self._frame_key(self._shown_params), self.result, self._png)
         self._widget = None
         self._view = None
 
@@ -229,6 +230,18 @@ class Explorer:
     def params(self) -> dict[str, Any]:
         """The current value of every control, by name."""
         return {name: w.value for name, w in self.controls.items()}
+
+    def _settings_now(self) -> tuple[dict[str, Any], dict[str, Any]]:
+        """The controls' settings as the browser sees them (`view_values`) and as parameters,
+        each control read once: a front end may change the controls from another thread while
+        a frame is drawn, and the frame must be labelled with the settings it was drawn for."""
+        values, params = {}, {}
+        for name, w in self.controls.items():
+            if hasattr(w, "index"):
+                values[name], params[name] = w.index, w.value
+            else:
+                values[name] = params[name] = w.value
+        return values, params
 
     @property
     def png(self) -> bytes:
@@ -243,7 +256,8 @@ class Explorer:
         and drawn again; the figure's artists are still updated, so they always match what is
         shown.
         """
-        key = self._frame_key(self.params)
+        self._shown_values, self._shown_params = self._settings_now()
+        key = self._frame_key(self._shown_params)
         cached = self._cache.get(key)
         if cached is not None:
             self._cache.move_to_end(key)
@@ -251,7 +265,7 @@ class Explorer:
             self._update(self.handles, self.result)
             self._send()
             return
-        self.result = self._compute(**self.params)
+        self.result = self._compute(**self._shown_params)
         self._update(self.handles, self.result)
         self._show()
 
@@ -303,7 +317,7 @@ class Explorer:
     def _show(self) -> None:
         """Draw a frame of the figure as it is now, remember it and send it to the view."""
         self._png = self.frames.frame()
-        self._remember(self._frame_key(self.params), self.result, self._png)
+        self._remember(self._frame_key(self._shown_params), self.result, self._png)
         self._send()
 
     def _send(self) -> None:
@@ -312,7 +326,7 @@ class Explorer:
             height, width = self.frames.canvas.buffer_rgba().shape[:2]
             with self._view.hold_sync():
                 self._view.png = self._png
-                self._view.values = view_values(self.controls)
+                self._view.values = self._shown_values
                 self._view.css_width = width / ratio
                 self._view.css_height = height / ratio
                 self._view.alt = self._alt_text()
@@ -361,7 +375,7 @@ class Explorer:
 
     def _settings(self) -> str:
         return ", ".join(f"{k}={v:g}" if isinstance(v, (int, float)) else f"{k}={v!r}"
-                         for k, v in self.params.items())
+                         for k, v in self._shown_params.items())
 
     def _alt_text(self) -> str:
         return f"{self.title} ({self._settings()})"
@@ -374,7 +388,7 @@ class Explorer:
 
             from ._view import FigureView
             self._view = FigureView(png=self._png, alt=self._alt_text(), controls=self.controls,
-                                    values=view_values(self.controls), ahead=bool(self.frames_ahead),
+                                    values=self._shown_values, ahead=bool(self.frames_ahead),
                                     css_width=float(self.frames.canvas.buffer_rgba().shape[1]),
                                     css_height=float(self.frames.canvas.buffer_rgba().shape[0]))
             # every callback on the kernel's main thread, whichever thread a message arrives on
