@@ -65,16 +65,22 @@ function setting(m) {
   return index === undefined ? m.get("value") : index;
 }
 
-// the positions of a slider nearest `value` first, then further out, both ways
+// the positions of a slider around `value`: the nearest few both ways (a key step), then on
+// towards the farther end of the range (where a hand has room to go), then towards the nearer
+// one; one step apart after the first few, so the kernel mostly redraws only what moved
+const NEAREST = 3;
 function* positions(m, value) {
   const min = m.get("min"), max = m.get("max"), step = m.get("step");
   if (!(step > 0) || !(max > min)) return;
   const count = Math.floor((max - min) / step + 1e-9);
   const here = Math.round((value - min) / step);
-  for (let k = 1; k <= count; k++) {
-    for (const i of [here + k, here - k]) {
-      if (i >= 0 && i <= count) yield Number((min + i * step).toPrecision(12));
-    }
+  const at = i => Number((min + i * step).toPrecision(12));
+  for (let k = 1; k <= NEAREST; k++) {
+    for (const i of [here + k, here - k]) if (i >= 0 && i <= count) yield at(i);
+  }
+  const up = count - here >= here;
+  for (const direction of up ? [1, -1] : [-1, 1]) {
+    for (let i = here + direction * (NEAREST + 1); i >= 0 && i <= count; i += direction) yield at(i);
   }
 }
 
