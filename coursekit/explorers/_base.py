@@ -127,20 +127,33 @@ def view_values(controls: dict[str, Any]) -> dict[str, Any]:
     return {name: w.index if hasattr(w, "index") else w.value for name, w in controls.items()}
 
 
+def settings_now(controls: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
+    """The controls' settings as the browser sees them (`view_values`) and as parameters, each
+    control read once: a front end may change the controls from another thread while a frame is
+    drawn, and a frame must be labelled with the settings it was drawn for."""
+    values, params = {}, {}
+    for name, w in controls.items():
+        if hasattr(w, "index"):
+            values[name], params[name] = w.index, w.value
+        else:
+            values[name] = params[name] = w.value
+    return values, params
+
+
 def requested_params(controls: dict[str, Any], values) -> dict[str, Any] | None:
     """The parameters for settings `values` the browser asks a frame for, or None when they do
     not fit: every control named, each slider at a finite number within its range (a whole one
     for an IntSlider), every other control at its current setting."""
     if not isinstance(values, dict) or set(values) != set(controls):
         return None
-    shown = view_values(controls)
+    shown, now = settings_now(controls)
     params = {}
     for name, w in controls.items():
         value = values[name]
         if not _is_slider(w):
             if value != shown[name]:
                 return None
-            params[name] = w.value
+            params[name] = now[name]
             continue
         if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
             return None
@@ -232,16 +245,7 @@ class Explorer:
         return {name: w.value for name, w in self.controls.items()}
 
     def _settings_now(self) -> tuple[dict[str, Any], dict[str, Any]]:
-        """The controls' settings as the browser sees them (`view_values`) and as parameters,
-        each control read once: a front end may change the controls from another thread while
-        a frame is drawn, and the frame must be labelled with the settings it was drawn for."""
-        values, params = {}, {}
-        for name, w in self.controls.items():
-            if hasattr(w, "index"):
-                values[name], params[name] = w.index, w.value
-            else:
-                values[name] = params[name] = w.value
-        return values, params
+        return settings_now(self.controls)
 
     @property
     def png(self) -> bytes:
