@@ -16,11 +16,13 @@ reused while only curves and titles move, so a frame costs a few tens of
 milliseconds instead of a full draw.
 
 While an explorer is on screen, the browser also asks the kernel, one at a
-time, for the frames of the slider positions next to the current ones (nearest
-first, the slider under the pointer first) and keeps them; a slider moved to a
-position it holds shows that frame at once, without waiting for the kernel.
-The kernel draws such a frame without touching the controls or what is shown
-(`Explorer.frame_for`).
+time, for the frames of the slider positions around the current ones (the
+slider under the pointer first; see `FigureView`) and keeps them; a slider
+moved to a position it holds shows that frame at once, without waiting for the
+kernel. The kernel draws such a frame without touching the controls or what is
+shown (`Explorer.frame_for`). Every callback (a slider moved, a frame asked
+for, a screen report) runs on the kernel's main thread (`HomeThread`), since a
+front end may hand widget messages to another kernel thread.
 
 The figure is rendered at the pixel size it is shown with: the view reports
 the screen's device pixel ratio and the room available (the output width, and
@@ -227,7 +229,7 @@ class Explorer:
         self.natural_dpi = float(self.fig.dpi)
         self.handles = draw(self.fig)
         self.screen: dict = {}
-        self._shown_values, self._shown_params = self._settings_now()
+        self._shown_values, self._shown_params = settings_now(self.controls)
         self.result = self._compute(**self._shown_params)
         # update, then watch the update repeated: the artists it touches are the ones that move
         self._update(self.handles, self.result)
@@ -244,9 +246,6 @@ class Explorer:
         """The current value of every control, by name."""
         return {name: w.value for name, w in self.controls.items()}
 
-    def _settings_now(self) -> tuple[dict[str, Any], dict[str, Any]]:
-        return settings_now(self.controls)
-
     @property
     def png(self) -> bytes:
         """The figure as last drawn (PNG bytes, at the size it is shown with)."""
@@ -260,7 +259,7 @@ class Explorer:
         and drawn again; the figure's artists are still updated, so they always match what is
         shown.
         """
-        self._shown_values, self._shown_params = self._settings_now()
+        self._shown_values, self._shown_params = settings_now(self.controls)
         key = self._frame_key(self._shown_params)
         cached = self._cache.get(key)
         if cached is not None:

@@ -359,12 +359,16 @@ class FigureView(anywidget.AnyWidget):
     (raised when the kernel's frames change resolution, so the browser drops
     the ones it holds) and ``ahead`` (whether to ask for frames ahead).
 
-    While on screen, the view asks the kernel for the frames of the slider
-    positions next to the current settings, one request at a time (a custom
-    message ``{"type": "frame", "values": ..., "generation": ...}``, answered
-    by a ``"frame"`` message with the PNG as its buffer or by ``"no-frame"``),
-    and shows a held frame as soon as the controls reach its settings. It
-    keeps at most 48 MB of frames, dropping the least recently shown.
+    While on screen and while no cell of its notebook runs, the view asks the
+    kernel for the frames of the slider positions around the current settings,
+    one request at a time (a custom message ``{"type": "frame", "values": ...,
+    "generation": ..., "view": ...}``, answered by a ``"frame"`` message with
+    the PNG as its buffer or by ``"no-frame"``): a few steps both ways, then
+    step by step towards the farther end of each slider's range and back to the
+    nearer one, the slider under the pointer or with the focus first. It shows a
+    held frame as soon as the controls reach its settings, and keeps at most
+    48 MB of frames, dropping first those least recently shown and away from the
+    current settings.
     """
 
     _esm = _ESM
