@@ -126,13 +126,14 @@ def _is_slider(widget) -> bool:
 
 def view_values(controls: dict[str, Any]) -> dict[str, Any]:
     """The controls' settings as the browser sees them: a slider's value, a choice's index."""
-    return {name: w.index if hasattr(w, "index") else w.value for name, w in controls.items()}
+    return settings_now(controls)[0]
 
 
 def settings_now(controls: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """The controls' settings as the browser sees them (`view_values`) and as parameters, each
-    control read once: a front end may change the controls from another thread while a frame is
-    drawn, and a frame must be labelled with the settings it was drawn for."""
+    """The controls' settings as the browser sees them (a slider's value, a choice's index) and
+    as parameters, each control read once: a front end may change the controls from another
+    thread while a frame is drawn, and a frame must be labelled with the settings it was drawn
+    for."""
     values, params = {}, {}
     for name, w in controls.items():
         if hasattr(w, "index"):

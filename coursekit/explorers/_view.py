@@ -59,7 +59,7 @@ async function controlModels(model) {
   })));
 }
 
-// a setting as the kernel's view_values gives it: a choice's index, another control's value
+// a setting as the kernel's settings_now gives it: a choice's index, another control's value
 function setting(m) {
   const index = m.get("index");
   return index === undefined ? m.get("value") : index;
