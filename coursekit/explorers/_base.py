@@ -285,10 +285,12 @@ class Explorer:
         if cached is not None:
             return cached[1]
         result = self._compute(**params)
-        self._update(self.handles, result)
-        png = self.frames.frame()
+        try:
+            self._update(self.handles, result)
+            png = self.frames.frame()
+        finally:                     # also when the update or the drawing fails halfway
+            self._update(self.handles, self.result)
         self._remember(key, result, png)
-        self._update(self.handles, self.result)
         return png
 
     def forget_frames(self) -> None:
@@ -372,7 +374,6 @@ class Explorer:
         try:
             png = self.frame_for(params)
         except Exception:   # noqa: BLE001 - the user meets the error when moving there
-            self._update(self.handles, self.result)
             view.send(reply)
             return
         view.send({**reply, "type": "frame"}, [png])
