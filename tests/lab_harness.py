@@ -34,7 +34,7 @@ __all__ = ["CHROMIUM_ARGS", "TOKEN", "VIEWPORT", "HarnessError", "chromium_path"
            "write_notebook", "running_lab", "launched_chromium", "new_lab_page", "open_notebook",
            "run_all", "wait_until_done", "close_all", "shut_down_kernels", "install_probe",
            "probe_state", "execute_in_kernel", "EXPLORER", "first_slider", "drag", "wait_until_quiet",
-           "error_outputs"]
+           "error_outputs", "stderr_lines"]
 
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync", "--no-first-run"]
@@ -231,22 +231,30 @@ def open_notebook(page, name: str) -> None:
 
 
 def error_outputs(page) -> list[str]:
-    """Tracebacks and stderr in the active notebook's outputs, error and stderr messages of its
-    kernel (widget callbacks included; not the widget manager's refused control comm, see
+    """Tracebacks and stderr in the active notebook's outputs, error messages and stderr lines of
+    its kernel (widget callbacks included; not the widget manager's refused control comm, see
     `_OPEN_AND_WATCH_JS`), and uncaught errors in the page."""
     watch = page.evaluate("() => window.__ckKernelWatch") or {"stderr": [], "errors": [], "controlComms": []}
     return (page.evaluate(_ERRORS_JS) + watch["errors"]
-            + [text for text in watch["stderr"] if not _harmless(text, set(watch["controlComms"]))]
+            + stderr_lines(watch["stderr"], set(watch["controlComms"]))
             + list(page.ck_page_errors))
 
 
-def _harmless(stderr: str, control_comms: set[str]) -> bool:
-    """True when every line of `stderr` is the kernel refusing a widget control comm."""
-    for line in filter(None, (line.strip() for line in stderr.splitlines())):
-        match = _HARMLESS_STDERR.fullmatch(line)
-        if match is None or (match[1] is not None and match[1] not in control_comms):
-            return False
-    return True
+def stderr_lines(chunks: list[str], control_comms: set[str]) -> list[str]:
+    """The non-blank lines of the kernel's stderr stream, given as the `chunks` its messages
+    carried, without the kernel's refusals of the widget control comms `control_comms`.
+
+    The kernel cuts its stream into messages wherever it flushes, so one line may come in
+    several messages (a printed text and its newline, for example): lines are taken from the
+    whole stream, not from each message."""
+    lines = (line.strip() for line in "".join(chunks).splitlines())
+    return [line for line in lines if line and not _harmless(line, control_comms)]
+
+
+def _harmless(line: str, control_comms: set[str]) -> bool:
+    """True when `line` is the kernel refusing one of the widget control comms `control_comms`."""
+    match = _HARMLESS_STDERR.fullmatch(line)
+    return match is not None and (match[1] is None or match[1] in control_comms)
 
 
 def run_all(page) -> None:

@@ -267,7 +267,7 @@ def test_kernel_errors_are_reported_but_not_the_widget_managers_control_probe(pa
         page.wait_for_timeout(500)
         errors = lab_h.error_outputs(page)
     assert printed.strip() == "stderr from the kernel"
-    assert errors == ["stderr from the kernel\n"], errors
+    assert errors == ["stderr from the kernel"], errors
 
 
 def _readout_value(page) -> float:
