@@ -109,7 +109,10 @@ _LADDER = 30
 _TABLEAU = 6
 _ABSOLUTE_TOP = 0.25
 _RELATIVE = 16.0
-_OTHER = 0.6            # the second absolute ladder's top step, in units of the first's
+# the second absolute ladder's top step, in units of the first's: the golden ratio's inverse,
+# the number farthest from every fraction, so that no period of an oscillating f divides the
+# steps of both ladders (with 0.6 = 3/5 a sine of period 0.25/2400 fooled both alike)
+_OTHER = (np.sqrt(5.0) - 1.0) / 2.0
 
 
 def _probe(g: Callable, z: np.ndarray):
@@ -180,22 +183,44 @@ def _ridders_column(D: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, float
 
 
 def _column(g: Callable, z: np.ndarray, k: int, q: int) -> tuple[np.ndarray, float]:
-    """(dg/dz_k, error estimate) from the absolute ladder, or the relative one where it agrees.
+    """(dg/dz_k, error estimate) from the absolute ladders, or the relative one where it agrees.
 
     The tableau's own estimate can be fooled by noise or a kink (a lucky
     agreement of two entries), so a second absolute ladder on other points
-    (its top step is not a power of two times the first's) is computed as
-    well, and the two results' disagreement is a lower bound of the error.
+    (its top step is not a rational multiple of the first's) is computed as
+    well, and the two results' disagreement is a lower bound of the error
+    (`_agreed`).
     """
-    J, err = _ridders_column(*_quotient_ladder(g, z, k, q, _ABSOLUTE_TOP))
-    J_other, err_other = _ridders_column(*_quotient_ladder(g, z, k, q, _ABSOLUTE_TOP * _OTHER))
-    err = max(err, err_other, float(np.abs(J - J_other).max()))
+    J, err = _agreed([_quotient_ladder(g, z, k, q, _ABSOLUTE_TOP * scale) for scale in (1.0, _OTHER)])
     if abs(z[k]) > _RELATIVE:
         h0 = 2.0 ** np.round(np.log2(abs(z[k]))) / 4
         J_rel, err_rel = _ridders_column(*_quotient_ladder(g, z, k, q, h0))
         if err_rel < err and np.abs(J_rel - J).max() <= err + err_rel:
             return J_rel, err_rel
     return J, err
+
+
+def _agreed(ladders: list) -> tuple[np.ndarray, float]:
+    """(column, error estimate) from two ladders (D, noise): the first's Ridders result, with
+    the largest of both tableaus' estimates and of the two results' difference as its error.
+
+    Where the two results differ by more than their own estimates, the largest steps may have
+    fooled one tableau: a function that oscillates faster than the largest steps resolve (a
+    sine of period 1e-4) looks like a straight line to steps that are near multiples of its
+    period, and several such steps agree to the last digit. Their rows are then left out,
+    the largest first, and the result whose error is smallest is kept. A tableau's own
+    estimate only grows as rows are left out, so the search ends once it exceeds the best.
+    """
+    best, best_err = None, np.inf
+    for top in range(_LADDER - _TABLEAU):
+        (J, err), (J_other, err_other) = (_ridders_column(D[top:], noise[top:]) for D, noise in ladders)
+        own = max(err, err_other)
+        total = max(own, float(np.abs(J - J_other).max()))
+        if total < best_err:
+            best, best_err = J, total
+        if total <= own or own >= best_err:
+            break
+    return best, best_err
 
 
 def _ridders(g: Callable, z: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
@@ -296,8 +321,10 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     |x_k| > 16, a second ladder from |x_k| / 4, used where it agrees),
     extrapolated (Richardson, up to h^12) and chosen by its error estimate
     (Ridders' method), which is cross-checked against a second ladder on
-    other points (a noisy or kinked f makes the two disagree). The step does not grow with |x*|: for smooth f the
-    result is accurate to about 1e-10 relative to each column's size,
+    other points (a noisy or kinked f makes the two disagree; where the
+    largest steps alone disagree, as on a fast oscillation they cannot
+    resolve, they are left out). The step does not grow with |x*|: for
+    smooth f the result is accurate to about 1e-10 relative to each column's size,
     wherever x* lies (the pendulum at 1000 turns as at 0), and for
     polynomials and exponentials of large arguments as well. A column whose
     error estimate exceeds 1e-7 of its size gives an `AccuracyWarning` saying
