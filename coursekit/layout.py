@@ -119,16 +119,42 @@ def _wrap_outside_math(text) -> str:
     lines = []
     for source_line in text.get_text().split("\n"):
         words = _words_outside_math(source_line)
-        line = words[0]
-        for word in words[1:]:
-            longer = f"{line} {word}"
-            if text._get_rendered_text_width(longer) > width:
-                lines.append(line)
-                line = word
-            else:
-                line = longer
-        lines.append(line)
+        while words:
+            count = _words_that_fit(words, width, text._get_rendered_text_width)
+            lines.append(" ".join(words[:count]))
+            words = words[count:]
     return "\n".join(lines)
+
+
+def _words_that_fit(words: list[str], width: float, measure) -> int:
+    """How many of `words` go on one line: the most whose line, joined by spaces, `measure`s at
+    most `width` pixels, and at least one.
+
+    Each line is measured as drawn. A title redrawn for every slider position carries numbers
+    that change, so those measurements are new each time (about a millisecond each): rather
+    than measuring the line once per word added, the count is guessed from the widths of the
+    single words (most of which matplotlib has measured before) and then settled by measuring
+    the line with that many words and with one more, usually two measurements per line. A
+    line is wider for every word added, so this is the count that adding words one at a time
+    until the next would not fit arrives at.
+    """
+    space = measure("x x") - 2 * measure("x")
+    count, used = 0, -space
+    for word in words:
+        used += space + measure(word)
+        if used > width:
+            break
+        count += 1
+
+    def fits(k: int) -> bool:
+        return k == 1 or measure(" ".join(words[:k])) <= width
+
+    count = max(count, 1)
+    while not fits(count):
+        count -= 1
+    while count < len(words) and fits(count + 1):
+        count += 1
+    return count
 
 
 def _words_outside_math(line: str) -> list[str]:

@@ -6,6 +6,7 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
+from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.layout_engine import ConstrainedLayoutEngine, TightLayoutEngine  # noqa: E402
 
@@ -152,3 +153,58 @@ def test_a_wrapped_title_with_mathtext_breaks_only_outside_the_math(lecture):
 def test_titles_break_only_at_spaces_outside_formulas(line, words):
     from coursekit.layout import _words_outside_math
     assert _words_outside_math(line) == words
+
+
+def _greedy_lines(words, width, measure):
+    """The reference fill: add words one at a time while the line still fits."""
+    lines, line = [], words[0]
+    for word in words[1:]:
+        if measure(f"{line} {word}") > width:
+            lines.append(line)
+            line = word
+        else:
+            line = f"{line} {word}"
+    return lines + [line]
+
+
+_WORDS = ["a", "gain", "$k_1 = 2.35$", "poles", "at", "$-3 \\pm 4j$", "W", "observer", "-12.5",
+          "iii", "$\\omega_n = 10$ rad/s", "MMMM", "noise", "$R = 0.01$"]
+
+
+@pytest.mark.parametrize("size", [10, 18])
+def test_titles_fill_their_lines_as_adding_words_one_at_a_time_would(size):
+    from hypothesis import given, settings, strategies as st
+
+    from coursekit.layout import _words_that_fit
+    fig = Figure(figsize=(6, 4))
+    text = fig.text(0.5, 0.5, "x", fontsize=size)
+    FigureCanvasAgg(fig).draw()      # gives the text its renderer, which measures
+    measure = text._get_rendered_text_width
+
+    @settings(max_examples=150, deadline=None)
+    @given(st.lists(st.sampled_from(_WORDS), min_size=1, max_size=25), st.floats(5, 700))
+    def fill(words, width):
+        lines, rest = [], list(words)
+        while rest:
+            count = _words_that_fit(rest, width, measure)
+            lines.append(" ".join(rest[:count]))
+            rest = rest[count:]
+        assert lines == _greedy_lines(words, width, measure)
+
+    fill()
+
+
+@pytest.mark.parametrize("measure", [
+    lambda s: 7 * len(s) + 10 * s.count(" ") ** 2,        # a line wider than its words and spaces
+    lambda s: 7 * len(s) - 3 * s.count(" "),             # narrower (kerning, a thin space)
+], ids=["lines wider than their words", "lines narrower than their words"])
+def test_the_fill_corrects_its_guess_from_the_single_words(measure):
+    from coursekit.layout import _words_that_fit
+    words = "the observer poles at -3.5 and -4 with measurement noise 0.01 and a long tail".split()
+    for width in range(1, 700, 7):
+        lines, rest = [], list(words)
+        while rest:
+            count = _words_that_fit(rest, width, measure)
+            lines.append(" ".join(rest[:count]))
+            rest = rest[count:]
+        assert lines == _greedy_lines(words, width, measure), width
