@@ -70,6 +70,31 @@ def test_dragging_the_first_slider_gives_the_figure_of_a_fresh_draw(factory):
 
 
 @pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
+def test_a_drag_back_over_states_passed_before_reuses_their_backgrounds_and_draws_right(factory):
+    dragged = factory()
+    if dragged.frames._fixed_aspect():
+        pytest.skip("a figure with a fixed-aspect axes (the robot's path) is drawn whole every time")
+    name, widget = next(iter(_sliders(dragged).items()))
+    there = _drag_values(widget, moves=16)
+    path = there + there[::-1][1:]         # to the maximum, the minimum and back again
+    checked, states = 0, set()
+    for value in path:
+        reuses = dragged.frames.reuses
+        widget.value = value
+        dragged._cache.clear()             # draw each frame (not the explorer's copy of it)
+        dragged.refresh()
+        states.add(dragged.frames._key)
+        if dragged.frames.reuses > reuses and checked < 3:   # a frame on a background kept
+            checked += 1
+            fresh = factory()
+            fresh.controls[name].value = value
+            fresh.refresh()
+            np.testing.assert_array_equal(_pixels(dragged.png), _pixels(fresh.png), err_msg=f"{name} = {value}")
+    assert checked > 0 or len(states) == 1, "the way back drew every state whole again"
+    assert dragged.frames.full_draws <= len(states) + 1
+
+
+@pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
 def test_a_hand_moving_a_slider_step_by_step_draws_the_whole_figure_only_when_it_changed(factory):
     e = factory()
     if e.frames._fixed_aspect():

@@ -10,7 +10,9 @@ something in the background changes: a view limit, an axis label, the figure
 size or resolution, the number of lines of a moving text. (A figure with an
 axes of fixed aspect ratio, whose limits follow its place, is drawn whole.) The
 layout that matplotlib's constrained layout finds for a full draw is kept per
-state of the text around the axes, so a state seen before is not measured again.
+state of the text around the axes, so a state seen before is not measured again,
+and so is the background drawn for it (up to `BACKGROUND_BYTES`), so a slider
+dragged back over the states it passed is not drawn whole again either.
 
 Three rules make every frame identical to a fresh draw of the same figure:
 
@@ -36,10 +38,12 @@ from operator import attrgetter
 
 import numpy as np
 
-__all__ = ["FrameRenderer", "snap_limits", "encode_png"]
+__all__ = ["FrameRenderer", "snap_limits", "encode_png", "LAYOUTS_KEPT", "BACKGROUND_BYTES"]
 
 #: how many layouts a renderer keeps (one per state of the text around the axes)
 LAYOUTS_KEPT = 64
+#: the bytes of backgrounds a renderer keeps (one per state laid out; 3.7 MB at 1164 x 800 px)
+BACKGROUND_BYTES = 64 * 1024 * 1024
 
 
 def encode_png(rgba, dpi: float) -> bytes:
@@ -151,7 +155,8 @@ class FrameRenderer:
         ones that move (see `forget_changes`).
 
     Call `frame` after every change of the figure's artists. ``full_draws``
-    and ``blits`` count how each frame was made.
+    and ``blits`` count how each frame was made; ``reuses`` counts the blits
+    onto a background kept from an earlier visit of the same state of the axes.
     """
 
     def __init__(self, fig):
@@ -164,8 +169,10 @@ class FrameRenderer:
         self._key = None
         self._snapped: dict = {}           # the limits snap_limits left, by axes
         self._layouts: dict = {}           # axes places found by the layout engine, by state
+        self._backgrounds: dict = {}       # (background, redraw list) by layout key, for _moving
         self.full_draws = 0
         self.blits = 0
+        self.reuses = 0
         self.forget_changes()
 
     def forget_changes(self) -> None:
@@ -183,13 +190,14 @@ class FrameRenderer:
             if ax.get_aspect() == "auto":
                 self._snapped[ax] = snap_limits(ax, done=self._snapped.get(ax))
         moving = self._changed_units()
-        if (self._background is None or not moving <= self._moving or self._layout_key() != self._key
-                or self._fixed_aspect()):
+        if self._background is None or not moving <= self._moving or self._fixed_aspect():
             # an axes with a fixed aspect ratio sets its limits from its place as it is drawn:
             # such a figure is drawn whole every time
             self._full_draw(self._moving | moving)
-        else:
+        elif self._layout_key() == self._key or self._reuse_background():
             self._blit()
+        else:
+            self._full_draw(self._moving)
         return encode_png(self.canvas.buffer_rgba(), self.fig.dpi)
 
     # --- what changed ------------------------------------------------------------------------
@@ -242,17 +250,57 @@ class FrameRenderer:
 
     def _full_draw(self, moving: set) -> None:
         """Draw the figure without the moving artists (the background), keep it, draw them on top."""
-        for artist in self._redraw:
-            artist.set_animated(False)
         redraw = self._redraw_list(moving)
-        self._moving, self._redraw = (moving, redraw) if redraw is not None else (set(), [])
-        for artist in self._redraw:
-            artist.set_animated(True)
+        moving, redraw = (moving, redraw) if redraw is not None else (set(), [])
+        if moving != self._moving:
+            self._backgrounds.clear()        # they leave out other artists
+        self._moving = moving
+        self._animate(redraw)
         self._draw_background()
         self._background = self.canvas.copy_from_bbox(self.fig.bbox) if self._redraw else None
         self._draw_redraw_list()
         self._key = self._layout_key()
+        if self._background is not None:
+            self._keep_background()
         self.full_draws += 1
+
+    def _animate(self, redraw: list) -> None:
+        """Make `redraw` the artists drawn over the background: only they are animated (left
+        out of a full draw)."""
+        for artist in self._redraw:
+            artist.set_animated(False)
+        self._redraw = redraw
+        for artist in self._redraw:
+            artist.set_animated(True)
+
+    def _keep_background(self) -> None:
+        """Keep the background just drawn for its layout key, within `BACKGROUND_BYTES`: a
+        slider dragged back and forth passes the same few states of the axes again and again."""
+        self._backgrounds.pop(self._key, None)
+        self._backgrounds[self._key] = (self._background, self._redraw)
+        width, height = self.canvas.get_width_height(physical=True)
+        while len(self._backgrounds) > 1 and len(self._backgrounds) * 4 * width * height > BACKGROUND_BYTES:
+            self._backgrounds.pop(next(iter(self._backgrounds)))
+
+    def _reuse_background(self) -> bool:
+        """Put back the background kept for the figure's state, if any, with its axes places:
+        True when it was put back (the moving artists are then drawn over it as in a blit)."""
+        places = self._layouts.get(self._layout_state())
+        if places is None:
+            return False
+        for ax, place in zip(self.fig.axes, places):
+            ax.set_position(place)
+            ax.set_in_layout(True)           # set_position takes an axes out of the layout
+        key = self._layout_key()
+        kept = self._backgrounds.pop(key, None)
+        if kept is None:
+            return False
+        self._backgrounds[key] = kept        # used last: dropped last
+        self._background, redraw = kept
+        self._animate(redraw)
+        self._key = key
+        self.reuses += 1
+        return True
 
     def _draw_background(self) -> None:
         """Draw the figure, laying it out only for a state not laid out before.
