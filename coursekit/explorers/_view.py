@@ -227,7 +227,7 @@ function render({ model, el }) {
   // and no cell runs
   let later = null;
   function ask() {
-    if (asked || !controls || !visible || document.hidden || !model.get("ahead")) return;
+    if (asked || !controls || !visible || document.hidden || !model.get("ahead") || pressed) return;
     if (cellsRunning(el)) {
       if (later === null) later = setTimeout(() => { later = null; ask(); }, 500);
       return;
@@ -281,6 +281,12 @@ function render({ model, el }) {
     if (index >= 0 && index < controls.length) focus = controls[index].name;
   }
 
+  // while a hand holds a control (a drag), the kernel answers the control alone: a frame
+  // ahead asked for then would make the drag's next frame wait
+  let pressed = false;
+  const press = event => { if (event.target.closest?.(".ck-controls")) pressed = true; };
+  const release = () => { if (pressed) { pressed = false; ask(); } };
+
   let removed = false;
   const onControl = () => { display(); ask(); };
   const onAlt = () => { img.alt = model.get("alt"); };
@@ -299,6 +305,9 @@ function render({ model, el }) {
   const explorer = el.closest(".ck-explorer");
   explorer?.addEventListener("pointerover", pointAt);
   explorer?.addEventListener("focusin", pointAt);
+  explorer?.addEventListener("pointerdown", press);
+  window.addEventListener("pointerup", release);
+  window.addEventListener("pointercancel", release);
   const seen = new IntersectionObserver(entries => {
     visible = entries.some(e => e.isIntersecting);
     ask();
@@ -323,6 +332,9 @@ function render({ model, el }) {
     document.removeEventListener("visibilitychange", ask);
     explorer?.removeEventListener("pointerover", pointAt);
     explorer?.removeEventListener("focusin", pointAt);
+    explorer?.removeEventListener("pointerdown", press);
+    window.removeEventListener("pointerup", release);
+    window.removeEventListener("pointercancel", release);
     if (asked) clearTimeout(asked.timer);
     if (later !== null) clearTimeout(later);
     frames.clear(null, null);
