@@ -287,6 +287,6 @@ def integral_action_explorer() -> Explorer:
 
     return Explorer(
         title="Integral action (3.110)-(3.120) on the CCF (3.27), a0 = 6, a1 = -5",
-        controls=dict(d=slider(1.0, -INTEGRAL_D_MAX, INTEGRAL_D_MAX, 0.25, "disturbance d"),
+        controls=dict(d=slider(1.0, -INTEGRAL_D_MAX, INTEGRAL_D_MAX, 0.1, "disturbance d"),
                       integral_pole=slider(-1.0, -6.0, -0.2, 0.1, "integral pole [1/s]")),
         compute=integral_action_compute, draw=draw, update=update, figsize=(12, 4.5))

@@ -173,7 +173,7 @@ def kalman_tuning_compute(log10_q: float, log10_r: float, *, seed: int = 0, t_en
                 poles=np.linalg.eigvals(sys.A - L @ sys.C), rms=rms, rms_matched=rms_m, L_matched=L_m)
 
 
-def _log_slider(true_value: float, low: float, high: float, description: str, step: float = 0.25):
+def _log_slider(true_value: float, low: float, high: float, description: str, step: float = 0.1):
     """A slider for log10 of a noise intensity, starting at the true one: its range, about
     [low, high], is moved so that the true value is one of its steps (a browser's slider moves
     a value between steps to the nearest one, and the figure would start at a wrong intensity)."""
