@@ -238,6 +238,38 @@ def test_encode_png_drops_alpha_only_when_every_pixel_is_opaque():
     assert see_through.shape == (6, 5, 4) and see_through[0, 0, 3] == 0
 
 
+def test_a_shared_time_axis_set_by_hand_keeps_its_limits_plus_margins():
+    # the second axes of a shared time axis snapped it again: [0, 10] was shown as [-6, 16]
+    fig = Figure(figsize=(6, 4))
+    top, bottom = fig.subplots(2, 1, sharex=True)
+    t = np.linspace(0, 10, 50)
+    lines = top.plot([], []) + bottom.plot([], [])
+    frames = FrameRenderer(fig)
+    for k in range(3):
+        for line in lines:
+            line.set_data(t, np.sin(t + k))
+        top.set_xlim(0, 10)
+        frames.frame()
+        assert top.get_xlim() == bottom.get_xlim() == pytest.approx((-0.5, 10.5))
+
+
+@pytest.mark.parametrize("factory", [ch1.euler_explorer, ch2.planner_explorer, ch4.observer_noise_explorer,
+                                     ch4.kalman_tuning_explorer], ids=lambda f: f.__name__)
+def test_the_explorers_time_axes_show_the_simulated_time(factory):
+    e = factory()
+    widget = next(iter(_sliders(e).values()))
+    for value in _drag_values(widget, moves=4):
+        widget.value = value
+        e._cache.clear()                   # draw the frame (a frame kept is not drawn again)
+        e.refresh()
+        # the axes share their time axis: the simulated time is that of all their curves
+        times = np.concatenate([line.get_xdata() for ax in e.fig.axes for line in ax.get_lines()
+                                if len(line.get_xdata()) > 1])
+        lo, hi = times.min(), times.max()
+        for ax in e.fig.axes:
+            assert ax.get_xlim() == pytest.approx((lo - 0.05 * (hi - lo), hi + 0.05 * (hi - lo))), value
+
+
 def test_snapping_limits_set_by_hand_again_does_not_widen_them():
     ax = Figure().subplots()
     ax.set_xlim(-8.0, 8.0)

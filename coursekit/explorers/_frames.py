@@ -80,7 +80,7 @@ def _with_margin(axis, lo: float, hi: float, margin: float) -> tuple[float, floa
     return tuple(scale.inverted().transform([a - pad, b + pad]))
 
 
-def snap_limits(ax, *, done=None) -> dict:
+def snap_limits(ax, *, done=None, skip=()) -> dict:
     """Put the view limits of `ax` on round numbers that change in steps, not continuously.
 
     The data range of an autoscaled axis, and limits set by hand that are not
@@ -93,11 +93,15 @@ def snap_limits(ax, *, done=None) -> dict:
 
     `done` is what the previous call returned: limits set by hand that are still
     the snapped ones are left as they are (snapping them again would widen them
-    at every call). Returns the limits now, by axis name.
+    at every call). The axes named in `skip` ("x", "y") are left alone: an axis
+    shared with an axes snapped before has been snapped with it. Returns the
+    limits now, by axis name.
     """
     done = done or {}
     margins = dict(zip("xy", ax.margins()))
     for name, axis in (("x", ax.xaxis), ("y", ax.yaxis)):
+        if name in skip:
+            continue
         get, set_ = getattr(ax, f"get_{name}lim"), getattr(ax, f"set_{name}lim")
         auto = getattr(ax, f"get_autoscale{name}_on")()
         data = getattr(ax.dataLim, f"interval{name}")
@@ -184,11 +188,7 @@ class FrameRenderer:
 
     def frame(self) -> bytes:
         """Snap the view limits, draw the figure (blitting if possible) and return its PNG."""
-        for ax in self.fig.axes:
-            # an axes with a fixed aspect ratio widens its limits itself to the box when drawn;
-            # limits snapped by hand there would be cut to the box instead, data and all
-            if ax.get_aspect() == "auto":
-                self._snapped[ax] = snap_limits(ax, done=self._snapped.get(ax))
+        self._snap()
         moving = self._changed_units()
         if self._background is None or not moving <= self._moving or self._fixed_aspect():
             # an axes with a fixed aspect ratio sets its limits from its place as it is drawn:
@@ -199,6 +199,21 @@ class FrameRenderer:
         else:
             self._full_draw(self._moving)
         return encode_png(self.canvas.buffer_rgba(), self.fig.dpi)
+
+    def _snap(self) -> None:
+        """Snap the view limits of every axes (`snap_limits`), each shared axis once: snapping
+        the second axes of a shared time axis again would widen the limits the first one got
+        (a time axis [0, 10] went to [-6, 16])."""
+        snapped = []
+        for ax in self.fig.axes:
+            # an axes with a fixed aspect ratio widens its limits itself to the box when drawn;
+            # limits snapped by hand there would be cut to the box instead, data and all
+            if ax.get_aspect() != "auto":
+                continue
+            skip = [name for name in "xy"
+                    if any(getattr(ax, f"get_shared_{name}_axes")().joined(ax, other) for other in snapped)]
+            self._snapped[ax] = snap_limits(ax, done=self._snapped.get(ax), skip=skip)
+            snapped.append(ax)
 
     # --- what changed ------------------------------------------------------------------------
 
