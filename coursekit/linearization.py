@@ -216,7 +216,7 @@ def _agreed(ladders: list) -> tuple[np.ndarray, float]:
         (J, err), (J_other, err_other) = (_ridders_column(D[top:], noise[top:]) for D, noise in ladders)
         own = max(err, err_other)
         total = max(own, float(np.abs(J - J_other).max()))
-        if total < best_err:
+        if best is None or total < best_err:
             best, best_err = J, total
         if total <= own or own >= best_err:
             break
