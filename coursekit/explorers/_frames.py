@@ -303,9 +303,7 @@ class FrameRenderer:
         places = self._layouts.get(self._layout_state())
         if places is None:
             return False
-        for ax, place in zip(self.fig.axes, places):
-            ax.set_position(place)
-            ax.set_in_layout(True)           # set_position takes an axes out of the layout
+        self._place(places)
         key = self._layout_key()
         kept = self._backgrounds.pop(key, None)
         if kept is None:
@@ -345,14 +343,18 @@ class FrameRenderer:
             while len(self._layouts) > LAYOUTS_KEPT:
                 self._layouts.pop(next(iter(self._layouts)))
             return
-        for ax, place in zip(self.fig.axes, places):
-            ax.set_position(place)
-            ax.set_in_layout(True)           # set_position takes an axes out of the layout
+        self._place(places)
         self.fig.set_layout_engine("none")
         try:
             self.canvas.draw()
         finally:
             self.fig.set_layout_engine(engine)
+
+    def _place(self, places: list) -> None:
+        """Put the axes where a layout kept in `_layouts` placed them."""
+        for ax, place in zip(self.fig.axes, places):
+            ax.set_position(place)
+            ax.set_in_layout(True)           # set_position takes an axes out of the layout
 
     def _fixed_aspect(self) -> bool:
         return any(ax.get_aspect() != "auto" for ax in self.fig.axes)
