@@ -352,9 +352,6 @@ class Explorer:
             self.forget_frames()         # frames at the old resolution are not shown again
             if self._view is not None:
                 self._view.generation += 1   # nor those the browser holds
-        # the update again, so the view limits are the ones of the settings (fitted anew to the
-        # data and snapped), not the last frame's widened once more
-        self._update(self.handles, self.result)
         self._show()
 
     def _on_view_msg(self, view, content, buffers) -> None:
