@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from coursekit.explorers import ch1, ch2, ch3, ch4
-from coursekit.explorers._base import requested_params, view_values
+from coursekit.explorers._base import requested_params, settings_now
 
 FACTORIES = [ch1.euler_explorer, ch1.msd_explorer, ch2.planner_explorer, ch3.pole_placement_explorer,
              ch3.upright_pendulum_explorer, ch3.integral_action_explorer, ch4.observer_noise_explorer,
@@ -55,7 +55,7 @@ def test_a_frame_asked_for_ahead_is_the_frame_shown_when_the_slider_gets_there(f
     replies = _Replies(explorer)
     shown_png, shown_params, shown_view = explorer.png, explorer.params, replies.view.png
     for name in _sliders(explorer):
-        values = {**view_values(explorer.controls), name: _step_up(explorer.controls[name])}
+        values = {**settings_now(explorer.controls)[0], name: _step_up(explorer.controls[name])}
         content, buffers = replies.ask(explorer, values)
         assert content == {"type": "frame", "values": values, "generation": replies.view.generation,
                            "view": "v1"}
@@ -77,7 +77,7 @@ def test_the_robot_planners_frame_ahead_holds_the_path_of_its_settings():
     # its equal-aspect axes settle over draws (see test_explorer_frames), so its data, not pixels
     explorer = ch2.robot_planner_explorer()
     replies = _Replies(explorer)
-    values = {**view_values(explorer.controls), "x_T": 4.5}
+    values = {**settings_now(explorer.controls)[0], "x_T": 4.5}
     content, buffers = replies.ask(explorer, values)
     assert content["type"] == "frame" and buffers[0].startswith(b"\x89PNG")
     fresh = ch2.robot_planner_explorer()
@@ -94,7 +94,7 @@ def test_the_robot_planners_frame_ahead_holds_the_path_of_its_settings():
 def test_a_value_the_slider_reaches_by_another_rounding_finds_the_frame_asked_for():
     explorer = ch1.msd_explorer()
     replies = _Replies(explorer)
-    values = {**view_values(explorer.controls), "d": 0.1 + 0.2}      # 0.30000000000000004
+    values = {**settings_now(explorer.controls)[0], "d": 0.1 + 0.2}      # 0.30000000000000004
     assert replies.ask(explorer, values)[0]["type"] == "frame"
     draws = explorer.frames.full_draws + explorer.frames.blits
     explorer.controls["d"].value = 0.3
@@ -102,7 +102,7 @@ def test_a_value_the_slider_reaches_by_another_rounding_finds_the_frame_asked_fo
 
 
 def _bad_requests(explorer):
-    values = view_values(explorer.controls)
+    values = settings_now(explorer.controls)[0]
     return {
         "a control missing": {k: v for k, v in values.items() if k != "m"},
         "an unknown control": {**values, "mass": 1.0},
@@ -133,7 +133,7 @@ def test_a_request_for_an_old_resolution_is_refused_and_a_new_resolution_raises_
     before = replies.view.generation
     replies.view.screen = {"width": 400, "height": 300, "ratio": 2.0}
     assert replies.view.generation == before + 1
-    values = {**view_values(explorer.controls), "m": 1.1}
+    values = {**settings_now(explorer.controls)[0], "m": 1.1}
     assert replies.ask(explorer, values, generation=before)[0]["type"] == "no-frame"
     assert replies.ask(explorer, values)[0]["type"] == "frame"
 
@@ -141,7 +141,7 @@ def test_a_request_for_an_old_resolution_is_refused_and_a_new_resolution_raises_
 def test_an_int_slider_takes_whole_numbers_only():
     explorer = ch2.planner_explorer()
     replies = _Replies(explorer)
-    values = view_values(explorer.controls)
+    values = settings_now(explorer.controls)[0]
     assert replies.ask(explorer, {**values, "r": 2.5})[0]["type"] == "no-frame"
     content, buffers = replies.ask(explorer, {**values, "r": 3.0})
     assert content["type"] == "frame"
@@ -170,7 +170,7 @@ def test_settings_that_cannot_be_computed_or_drawn_are_refused_and_the_figure_st
         explorer._compute = failing_compute
     else:
         explorer._update = failing_update
-    content, buffers = replies.ask(explorer, {**view_values(explorer.controls), "m": 1.1})
+    content, buffers = replies.ask(explorer, {**settings_now(explorer.controls)[0], "m": 1.1})
     assert content["type"] == "no-frame" and not buffers
     assert explorer.png == shown
     np.testing.assert_array_equal(_pixels(explorer.frames.frame()), _pixels(shown))

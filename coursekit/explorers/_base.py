@@ -124,11 +124,6 @@ def _is_slider(widget) -> bool:
     return isinstance(widget, (widgets.FloatSlider, widgets.IntSlider))
 
 
-def view_values(controls: dict[str, Any]) -> dict[str, Any]:
-    """The controls' settings as the browser sees them: a slider's value, a choice's index."""
-    return settings_now(controls)[0]
-
-
 def settings_now(controls: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
     """The controls' settings as the browser sees them (a slider's value, a choice's index) and
     as parameters, each control read once: a front end may change the controls from another
