@@ -18,13 +18,8 @@ plots one line and calls ``plt.show()`` (``%matplotlib inline``, ipywidgets' def
 * lag after release: from mouse up to the paint of the last figure, once the figure has not
   changed for 1 s (0 when nothing changed after the release).
 
-Each explorer is measured twice: as students get it, the browser holding frames of the
-slider positions next to the current settings (asked for while the explorer is on screen
-and no cell runs and no hand holds a control: here between the drags and during the steps),
-and with ``Explorer.frames_ahead =
-False``, where every update is a round trip to the kernel. The floor runs before the first
-explorer and after every third measurement, so drift in the machine's speed affects both; its
-row pools those runs.
+The floor runs before the first explorer and after every third measurement, so drift in the
+machine's speed affects both; its row pools those runs.
 """
 
 from __future__ import annotations
@@ -53,7 +48,6 @@ LIGHT_MS = 25.0      # kernel compute + redraw at most this: "light", target 20 
 DRAG_S = 3.0
 RUN_TIMEOUT_S = 120
 STEP_QUIET_MS = 400
-ROUND_TRIP = " without frames ahead"   # the suffix of an explorer's second measurement
 
 
 def _paint_count(page) -> int:
@@ -132,16 +126,15 @@ def _schedule(explorers: list[str]) -> list[str]:
 
 
 def _notebook(label: str) -> str:
-    return f"{label.replace(ROUND_TRIP, '-round-trip')}.ipynb"
+    return f"{label}.ipynb"
 
 
 def _write_notebooks(root: Path, explorers: list[str]) -> None:
     lab_h.write_notebook(root / "floor.ipynb", FLOOR_SOURCE)
     for label in explorers:
-        module, factory = label.removesuffix(ROUND_TRIP).split(".")
-        switch = "\nfrom coursekit.explorers import Explorer\nExplorer.frames_ahead = False" if ROUND_TRIP in label else ""
+        module, factory = label.split(".")
         lab_h.write_notebook(root / _notebook(label), [
-            f"%matplotlib inline\nfrom coursekit.explorers.{module} import {factory}{switch}", f"{factory}()"])
+            f"%matplotlib inline\nfrom coursekit.explorers.{module} import {factory}", f"{factory}()"])
 
 
 def require_browser() -> None:
@@ -157,7 +150,6 @@ def run_browser(explorers: list[str], kernel_ms: dict, *, steps: int = 15,
     `kernel_ms` holds each explorer's compute + redraw time (ms), which makes it light or not."""
     require_browser()
     from playwright.sync_api import TimeoutError as PlaywrightTimeout
-    explorers = [variant for label in explorers for variant in (label, label + ROUND_TRIP)]
     results: dict[str, list[dict]] = {}
     with tempfile.TemporaryDirectory(prefix="coursekit-browser-bench-") as tmp:
         base = Path(tmp)
@@ -193,7 +185,7 @@ def _table(explorers: list[str], kernel_ms: dict, results: dict) -> list[str]:
                 f"| {statistics.median(r['lag'] for r in runs):.0f} ms |")
     for label in explorers:
         run = results[label][0]
-        ms = kernel_ms[label.removesuffix(ROUND_TRIP)]
+        ms = kernel_ms[label]
         light = " (light)" if ms <= LIGHT_MS else ""
         rows.append(f"| {label}{light} | {ms:.0f} ms | {statistics.median(run['steps']):.0f} ms "
                     f"| {max(run['steps']):.0f} ms | {statistics.median(run['steps']) / floor:.2f} "

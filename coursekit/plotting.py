@@ -121,7 +121,7 @@ def plot_response(result, which: str = "xu", *, state_names=None, output_names=N
         ax.grid(True, alpha=0.4)
     axes[-1].set_xlabel(_time_label(time_unit))
     name = getattr(result.system, "name", "") or "the system"
-    fig.suptitle(title if title is not None else f"Response of {name}")
+    fig.suptitle(title if title is not None else f"Response of {name}", wrap=True)
     return fig
 
 
@@ -225,7 +225,7 @@ def plot_state_plane(trajectories, *, states=(0, 1), labels=None, state_names=No
     ax.margins(0.25)
     ax.grid(True, alpha=0.4)
     ax.legend(loc="best")
-    ax.set_title(title)
+    ax.set_title(title, wrap=True)
     return fig
 
 
@@ -305,5 +305,5 @@ def plot_euler_comparison(exact, approximations, *, state: int = 0, state_name: 
     ax_err.set_xlabel(_time_label(time_unit))
     ax_err.grid(True, which="both", alpha=0.3)
     ax_err.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
-    fig.suptitle(title if title is not None else "Exact solution against Euler discretization (1.43)")
+    fig.suptitle(title if title is not None else "Exact solution against Euler discretization (1.43)", wrap=True)
     return fig

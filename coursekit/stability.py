@@ -140,7 +140,7 @@ def plot_poles(poles, *, dt=None, ax=None, title: str | None = None):
         ax.autoscale_view()
     ax.set_xlabel("real part [1/s]" if dt is None else "real part")
     ax.set_ylabel("imaginary part [rad/s]" if dt is None else "imaginary part")
-    ax.set_title(title or ("Poles (continuous time)" if dt is None else "Poles (discrete time)"))
+    ax.set_title(title or ("Poles (continuous time)" if dt is None else "Poles (discrete time)"), wrap=True)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     ax.grid(True, alpha=0.3)
     return fig, ax

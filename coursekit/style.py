@@ -11,7 +11,12 @@ import numpy as np
 
 from ._validation import as_flag, as_integer, as_vector
 
-__all__ = ["lecture_mode", "is_lecture_mode", "new_figure", "LECTURE_STYLE"]
+__all__ = ["lecture_mode", "is_lecture_mode", "new_figure", "fit_margins", "LECTURE_STYLE"]
+
+#: space around each axes' decorations and at the figure's edges, in inches (4 points)
+_PAD = 4 / 72
+#: extra space between neighbouring axes, as a fraction of the figure's width (height)
+_SPACE = 0.02
 
 #: matplotlib settings applied by ``lecture_mode(True)``.
 LECTURE_STYLE = {
@@ -64,7 +69,6 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplot_kw):
     it as the last expression of a notebook cell.
     """
     from matplotlib.figure import Figure
-    from .layout import fit_margins
     nrows = as_integer(nrows, "nrows", minimum=1, why="one row of axes at least")
     ncols = as_integer(ncols, "ncols", minimum=1, why="one column of axes at least")
     if figsize is not None:
@@ -76,3 +80,29 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplot_kw):
     fig = fit_margins(Figure(figsize=figsize))
     axes = fig.subplots(nrows, ncols, squeeze=True, **subplot_kw)
     return fig, axes
+
+
+def fit_margins(fig):
+    """Lay `fig` out with matplotlib's constrained layout and the course's pads; returns `fig`.
+
+    Each time the figure is drawn, its margins and the gaps between its axes are measured
+    from the text they hold (tick labels, axis labels, titles, colorbars, legends placed
+    outside the axes, the suptitle), so all of it stays inside the figure and clear of the
+    neighbouring axes at any font size, lecture mode included. Every figure coursekit draws
+    uses it (`new_figure`). Call it before adding colorbars; a figure that already has a
+    layout engine keeps it. Raises ValueError if `fig` is not a Figure, or if a colorbar was
+    added without an engine in a way constrained layout cannot lay out.
+    """
+    from matplotlib.figure import Figure
+    if not isinstance(fig, Figure):
+        raise ValueError(f"fig must be a matplotlib Figure: received {type(fig).__name__}; "
+                         "pass the figure (fig, not an Axes), e.g. fig, ax = new_figure().")
+    if fig.get_layout_engine() is not None:
+        return fig
+    if any(spec is not None and spec.get_topmost_subplotspec() is not spec
+           for spec in (ax.get_subplotspec() for ax in fig.axes)):
+        raise ValueError("fig has a colorbar that splits an axes' grid cell (fig.colorbar(im, ax=ax) "
+                         "called before fit_margins), which constrained layout cannot lay out: "
+                         "call ck.fit_margins(fig) first, then add the colorbar.")
+    fig.set_layout_engine("constrained", w_pad=_PAD, h_pad=_PAD, wspace=_SPACE, hspace=_SPACE)
+    return fig

@@ -458,7 +458,7 @@ def plot_plan(t, x, u, *, title: str):
     for ax in (ax_x, ax_u):
         ax.grid(True, alpha=0.4)
         ax.legend()
-    fig.suptitle(title)
+    fig.suptitle(title, wrap=True)
     return fig
 
 

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 import coursekit as ck
-from coursekit.explorers import Explorer, slider
+from coursekit.explorers import Explorer, dropdown, int_slider, slider
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -55,7 +55,7 @@ def test_mimebundle_holds_the_widget_view_and_a_static_png():
     assert bundle["application/vnd.jupyter.widget-view+json"]["model_id"] == exp.widget.model_id
     png = base64.b64decode(bundle["image/png"])
     assert png.startswith(PNG_MAGIC)
-    assert bundle["text/plain"] == "Demo (static figure for a=1)"
+    assert bundle["text/plain"] == "Demo. Settings: a = 1."
 
 
 def test_moving_a_slider_refreshes_the_png_and_the_image_widget():
@@ -110,7 +110,7 @@ def executed_demo():
     nb = nbformat.v4.new_notebook()
     nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
     nb.cells = [nbformat.v4.new_code_cell(
-        "import numpy as np\nfrom coursekit.explorers import Explorer, slider\n"
+        "import numpy as np\nfrom coursekit.explorers import Explorer, dropdown, int_slider, slider\n"
         "Explorer(title='Demo', controls={'a': slider(1.0, 0.1, 3.0, 0.1, 'a')},\n"
         "         compute=lambda a: np.exp(-a * np.linspace(0, 5, 50)),\n"
         "         draw=lambda fig: fig.subplots().plot([], [])[0],\n"
@@ -147,12 +147,82 @@ def test_html_export_with_widget_state_stores_the_figure_view(executed_demo):
     assert "application/vnd.jupyter.widget-view+json" in html and "VBox(" not in html
 
 
+def _readout_explorer():
+    def compute(a):
+        if a > 2.5:
+            raise ZeroDivisionError("no response above a = 2.5")
+        return _compute(a)
+    return Explorer(title="Demo", controls={"a": slider(1.0, 0.1, 3.0, 0.1, "a [1/s]")}, compute=compute,
+                    draw=_draw, update=_update, readout=lambda r: f"peak {r[1].max():.3g} m\nsecond line")
+
+
+def test_the_readout_shows_the_numbers_and_joins_the_text_alternative():
+    exp = _readout_explorer()
+    widget = exp.widget
+    assert exp.text == "peak 1 m\nsecond line"
+    assert exp.alt == "Demo. Settings: a = 1. peak 1 m\nsecond line"
+    readout = widget.children[2]
+    assert "peak 1 m<br>second line" in readout.value
+    assert widget.children[-1].alt == exp.alt
+
+
+def test_a_compute_that_fails_for_a_setting_keeps_the_figure_and_says_why():
+    exp = _readout_explorer()
+    widget = exp.widget
+    shown = exp.png
+    exp.controls["a"].value = 2.8                    # no exception reaches the widget callback
+    assert exp.png == shown and exp.error.startswith("ZeroDivisionError: no response above")
+    assert "ck-error" in widget.children[2].value and "No figure for these settings" in exp.alt
+    exp.controls["a"].value = 2.0
+    assert exp.error is None and exp.png != shown and "ck-error" not in widget.children[2].value
+
+
+def test_a_compute_that_fails_for_the_first_settings_is_named():
+    with pytest.raises(ValueError, match=r"could not show its first settings \{'a': 1.0\}: KeyError"):
+        Explorer(title="Broken", controls={"a": slider(1.0, 0.1, 3.0, 0.1, "a")},
+                 compute=lambda a: {}["missing"], draw=_draw, update=_update)
+
+
+@pytest.mark.parametrize("call, match", [
+    (lambda: slider(float("nan"), 0, 1, 0.1, "a"), "value contains NaN"),
+    (lambda: slider(0.5, 0, 1, 0.0, "a"), "step must be positive"),
+    (lambda: slider(0.5, 0, 1, -0.1, "a"), "step must be positive"),
+    (lambda: slider(0.5, 0, float("inf"), 0.1, "a"), "max contains"),
+    (lambda: slider(0.5, 1, 0, 0.1, "a"), "min must be below max"),
+    (lambda: slider(2.0, 0, 1, 0.1, "a"), r"value must lie in \[min, max\]"),
+    (lambda: slider(0.5, 0, 1, 0.1, ""), "description must be a non-empty string"),
+    (lambda: int_slider(1, 0, 5, "n", step=0.5), "whole numbers"),
+    (lambda: dropdown([], None, "system"), "options must be a non-empty list"),
+    (lambda: dropdown(["a", "b"], "c", "system"), "value must be one of the options"),
+    (lambda: Explorer(title="x", controls={}, compute=_compute, draw=_draw, update=_update),
+     "controls must be a non-empty dict"),
+])
+def test_malformed_controls_are_refused_naming_the_argument(call, match):
+    with pytest.raises(ValueError, match=match):
+        call()
+
+
+@pytest.mark.parametrize("kwargs, match", [
+    (dict(controls={"a": 1.0}), r"controls\['a'\] must be a control"),
+    (dict(compute="not callable"), "compute must be a function"),
+    (dict(readout=3), "readout must be a function"),
+    (dict(title=None), "title must be a string"),
+])
+def test_explorer_arguments_of_the_wrong_type_are_refused(kwargs, match):
+    args = dict(title="x", controls={"a": slider(1.0, 0.1, 3.0, 0.1, "a")}, compute=_compute, draw=_draw,
+                update=_update)
+    with pytest.raises(TypeError, match=match):
+        Explorer(**{**args, **kwargs})
+
+
 def test_rescale_fits_the_view_to_data_moved_by_an_update():
     from matplotlib.figure import Figure
-    from coursekit.explorers._base import rescale
+    from coursekit.explorers import rescale
     ax = Figure().subplots()
     (line,) = ax.plot([0, 1], [0, 1])
     line.set_data([0, 10], [-5, 50])
     rescale(ax)
     lo, hi = ax.get_ylim()
-    assert lo <= -5 and hi >= 50 and ax.get_xlim()[1] >= 10
+    assert lo <= -5 and hi >= 50
+    rescale(ax, axis="x")
+    assert ax.get_xlim()[1] >= 10

@@ -89,13 +89,6 @@ def test_a_layout_engine_set_on_the_figure_is_kept():
     assert isinstance(fig.get_layout_engine(), TightLayoutEngine)
 
 
-def test_a_title_wider_than_the_figure_wraps_inside_it():
-    fig, ax = ck.new_figure(figsize=(4, 3))
-    ax.set_title("a title far wider than this small figure can hold on one line " * 2)
-    fig.suptitle("a suptitle far wider than this small figure can hold on one line " * 2)
-    assert text_problems(fig) == []
-
-
 def test_colorbars_added_after_fit_margins_are_laid_out():
     fig, axes = ck.new_figure(1, 2, figsize=(8, 3))
     for ax in axes:
@@ -119,92 +112,3 @@ def test_lecture_mode_figures_are_laid_out_too():
         assert text_problems(fig) == []
     finally:
         ck.lecture_mode(False)
-
-
-MATH_TITLE = (r"closed loop $\dot x = (A - B K)\, x$ with $K = [k_1 \quad k_2]$ "
-              r"from $x_0 = [1 \quad 0]^T$ for two gains")
-
-
-@pytest.mark.parametrize("lecture", [False, True], ids=["font size 18", "lecture mode"])
-def test_a_wrapped_title_with_mathtext_breaks_only_outside_the_math(lecture):
-    if lecture:
-        ck.lecture_mode()
-    try:
-        with matplotlib.rc_context({} if lecture else {"font.size": 18}):
-            fig, ax = ck.new_figure(figsize=(6, 4.5))
-            ax.plot(np.linspace(0, 10, 50), np.sin(np.linspace(0, 10, 50)))
-            ax.set_title(MATH_TITLE)
-            fig.suptitle(MATH_TITLE)
-            drawn = drawn_strings(fig)
-            problems = text_problems(fig)
-    finally:
-        ck.lecture_mode(False)
-    titles = [s for s, _ in drawn if "gains" in s or "closed" in s]
-    assert len(titles) >= 4, drawn                 # both titles wrapped onto several lines
-    assert not [s for s, math in drawn if "$" in s and not math], drawn
-    assert problems == []
-
-
-@pytest.mark.parametrize("line, words", [
-    ("gain $k = 2$ and $x_0 = [1\\ 0]$ now", ["gain", "$k = 2$", "and", "$x_0 = [1\\ 0]$", "now"]),
-    (r"costs \$5 or \$6 a day", [r"costs", r"\$5", "or", r"\$6", "a", "day"]),
-    ("one $ sign only", ["one", "$", "sign", "only"]),
-])
-def test_titles_break_only_at_spaces_outside_formulas(line, words):
-    from coursekit.layout import _words_outside_math
-    assert _words_outside_math(line) == words
-
-
-def _greedy_lines(words, width, measure):
-    """The reference fill: add words one at a time while the line still fits."""
-    lines, line = [], words[0]
-    for word in words[1:]:
-        if measure(f"{line} {word}") > width:
-            lines.append(line)
-            line = word
-        else:
-            line = f"{line} {word}"
-    return lines + [line]
-
-
-_WORDS = ["a", "gain", "$k_1 = 2.35$", "poles", "at", "$-3 \\pm 4j$", "W", "observer", "-12.5",
-          "iii", "$\\omega_n = 10$ rad/s", "MMMM", "noise", "$R = 0.01$"]
-
-
-@pytest.mark.parametrize("size", [10, 18])
-def test_titles_fill_their_lines_as_adding_words_one_at_a_time_would(size):
-    from hypothesis import given, settings, strategies as st
-
-    from coursekit.layout import _words_that_fit
-    fig = Figure(figsize=(6, 4))
-    text = fig.text(0.5, 0.5, "x", fontsize=size)
-    FigureCanvasAgg(fig).draw()      # gives the text its renderer, which measures
-    measure = text._get_rendered_text_width
-
-    @settings(max_examples=150, deadline=None)
-    @given(st.lists(st.sampled_from(_WORDS), min_size=1, max_size=25), st.floats(5, 700))
-    def fill(words, width):
-        lines, rest = [], list(words)
-        while rest:
-            count = _words_that_fit(rest, width, measure)
-            lines.append(" ".join(rest[:count]))
-            rest = rest[count:]
-        assert lines == _greedy_lines(words, width, measure)
-
-    fill()
-
-
-@pytest.mark.parametrize("measure", [
-    lambda s: 7 * len(s) + 10 * s.count(" ") ** 2,        # a line wider than its words and spaces
-    lambda s: 7 * len(s) - 3 * s.count(" "),             # narrower (kerning, a thin space)
-], ids=["lines wider than their words", "lines narrower than their words"])
-def test_the_fill_corrects_its_guess_from_the_single_words(measure):
-    from coursekit.layout import _words_that_fit
-    words = "the observer poles at -3.5 and -4 with measurement noise 0.01 and a long tail".split()
-    for width in range(1, 700, 7):
-        lines, rest = [], list(words)
-        while rest:
-            count = _words_that_fit(rest, width, measure)
-            lines.append(" ".join(rest[:count]))
-            rest = rest[count:]
-        assert lines == _greedy_lines(words, width, measure), width

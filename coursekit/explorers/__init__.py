@@ -4,6 +4,6 @@ Each explorer is a pure ``compute`` function (tested without a browser) plus
 a thin `Explorer` wrapper built by a ``*_explorer()`` function.
 """
 
-from ._base import Explorer, dropdown, figure_png, int_slider, slider
+from ._base import Explorer, dropdown, format_poles, int_slider, rescale, slider
 
-__all__ = ["Explorer", "slider", "int_slider", "dropdown", "figure_png"]
+__all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale", "format_poles"]

@@ -1,241 +1,231 @@
-"""The machinery shared by every explorer: sliders that redraw one figure as they move.
+"""The machinery shared by every explorer: controls that redraw one figure as they move.
 
-An explorer is three plain functions and a set of controls:
+An explorer is three plain functions, an optional fourth, and a set of controls:
+``compute(**params)``, pure numerics, unit-tested without a browser (where the
+course's algorithms are called); ``draw(fig)``, which builds the axes and empty
+artists once and returns handles; ``update(handles, result)``, which moves the
+artists' data and sets the view limits (`rescale` fits them to the data); and
+``readout(result)``, the numbers worth reading (gains, poles, a verdict), shown
+as text next to the controls and not in the figure.
 
-* ``compute(**params)`` -- pure numerics, no plotting, unit-tested without a
-  browser (this is where the course's algorithms are called);
-* ``draw(fig)`` -- builds the axes and empty artists once, returns handles;
-* ``update(handles, result)`` -- moves the artists' data to a new result.
-
-`Explorer` wires them to ipywidgets controls that report every move while a
-slider is dragged (``continuous_update=True``; the widget front end keeps at
-most one change in flight and sends only the latest value, so a redraw never
-falls behind the hand) and shows the figure in a `FigureView`. Each frame is
-drawn by a `FrameRenderer`: the axes, ticks and labels are drawn once and
-reused while only curves and titles move, so a frame costs a few tens of
-milliseconds instead of a full draw.
-
-While an explorer is on screen, the browser also asks the kernel, one at a
-time, for the frames of the slider positions around the current ones (the
-slider under the pointer first; see `FigureView`) and keeps them; a slider
-moved to a position it holds shows that frame at once, without waiting for the
-kernel. The kernel draws such a frame without touching the controls or what is
-shown (`Explorer.frame_for`). Every callback (a slider moved, a frame asked
-for, a screen report) runs on the kernel's main thread (`HomeThread`), since a
-front end may hand widget messages to another kernel thread.
-
-The figure is rendered at the pixel size it is shown with: the view reports
-the screen's device pixel ratio and the room available (the output width, and
-the visible height less the explorer's controls), and the figure is scaled
-down to fit. In `coursekit.lecture_mode` (switched on before the explorer is
-built) the figure also grows to fill the room, and the text in the figure and
-in the controls is larger.
-
-The explorer also carries a static PNG of the figure (at its natural size) in
-its display data, so a renderer without a live kernel (GitHub, nbviewer, an
-exported HTML page, the course website) shows the figure for the default
-parameters instead of an empty widget area.
+`Explorer` wires them to controls that report every move while a slider is
+dragged (the widget front end keeps one change in flight, then sends the latest
+value, so the figure ends on the value the hand stopped at). A `FrameRenderer`
+draws each frame, blitting while the axes stay; a `FigureView` shows it at the
+pixel size it was rendered with, for the room and pixel ratio the browser
+reports (in `coursekit.lecture_mode` it also grows to fill the room). Callbacks
+run on the kernel's main thread (`HomeThread`). The display data also carry a
+static PNG, for pages without a kernel (GitHub, nbviewer, the website).
 """
 
 from __future__ import annotations
 
 import base64
-from collections import OrderedDict
+import html
 from typing import Any, Callable
 
 import numpy as np
 
-from ._frames import FrameRenderer, encode_png
-from ._home import HomeThread
+from .._validation import as_scalar
+from ._frames import FrameRenderer
 
-__all__ = ["Explorer", "slider", "int_slider", "dropdown", "figure_png", "rescale"]
+__all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale", "format_poles"]
 
 #: an explorer is never shrunk below this fraction of its natural size to fit the screen
 MIN_SCALE = 0.45
-
 #: in lecture mode an explorer grows up to this factor to fill the room it has
 LECTURE_MAX_SCALE = 2.0
 
-#: how many recent frames an explorer keeps, for settings shown again
-FRAME_CACHE_SIZE = 128
 
-#: significant digits of a slider value in a frame's key: the browser's slider and its
-#: frames-ahead requests may reach the same position by different float roundings
-KEY_DIGITS = 12
+def _range(value, min, max, step, description):
+    """The slider's numbers, checked: finite, min < max, step > 0, min <= value <= max."""
+    if not isinstance(description, str) or not description.strip():
+        raise ValueError(f"description must be a non-empty string naming the quantity and its unit: "
+                         f"received {description!r}.")
+    value, low, high = (as_scalar(v, n) for v, n in ((value, "value"), (min, "min"), (max, "max")))
+    step = as_scalar(step, "step", positive=True)
+    if not low < high:
+        raise ValueError(f"min must be below max: received min={low:g}, max={high:g}.")
+    if not low <= value <= high:
+        raise ValueError(f"value must lie in [min, max] = [{low:g}, {high:g}]: received {value:g}.")
+    return value, low, high, step
 
 
-def _control_layout():
+def _style():
     import ipywidgets as widgets
-    return widgets.Layout(width="auto")
+    return dict(style={"description_width": "initial"}, layout=widgets.Layout(width="auto"))
 
 
 def slider(value: float, min: float, max: float, step: float, description: str, *,
            readout_format: str = ".3g"):
-    """A FloatSlider that reports every move while it is dragged."""
+    """A FloatSlider that reports every move while it is dragged; `description` names the
+    quantity with its unit (it is also the slider's accessible name)."""
     import ipywidgets as widgets
+    value, min, max, step = _range(value, min, max, step, description)
     return widgets.FloatSlider(value=value, min=min, max=max, step=step, description=description,
-                               continuous_update=True, readout_format=readout_format,
-                               style={"description_width": "initial"}, layout=_control_layout())
+                               continuous_update=True, readout_format=readout_format, **_style())
 
 
 def int_slider(value: int, min: int, max: int, description: str, *, step: int = 1):
     """An IntSlider that reports every move while it is dragged."""
     import ipywidgets as widgets
+    numbers = _range(value, min, max, step, description)
+    if any(x != int(x) for x in numbers):
+        raise ValueError(f"value, min, max and step must be whole numbers: received {numbers}.")
+    value, min, max, step = (int(x) for x in numbers)
     return widgets.IntSlider(value=value, min=min, max=max, step=step, description=description,
-                             continuous_update=True, style={"description_width": "initial"},
-                             layout=_control_layout())
+                             continuous_update=True, **_style())
 
 
 def dropdown(options, value, description: str):
-    """A Dropdown for a discrete choice (e.g. which controller)."""
+    """A Dropdown for a discrete choice (e.g. which system); `value` is one of `options`."""
     import ipywidgets as widgets
-    return widgets.Dropdown(options=options, value=value, description=description,
-                            style={"description_width": "initial"}, layout=_control_layout())
+    if isinstance(options, str) or not hasattr(options, "__iter__") or not list(options):
+        raise ValueError(f"options must be a non-empty list of choices: received {options!r}.")
+    options = list(options)
+    if value not in options:
+        raise ValueError(f"value must be one of the options {options}: received {value!r}.")
+    _range(0, 0, 1, 1, description)
+    return widgets.Dropdown(options=options, value=value, description=description, **_style())
 
 
-def rescale(*axes, min_span: float = 0.0) -> None:
-    """Fit each axes' view to the data its artists hold now (after ``set_data`` in an update).
+def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, keep: float = 0.5) -> None:
+    """Fit the view of each of `axes` to the data its artists hold (call it in an update).
 
-    With `min_span`, the vertical view spans at least that much, centred on the data: a
-    response that stays at a constant (a pendulum started upright) is drawn flat instead of
-    its numerical noise, a millionth of a unit, filling the axes.
+    The limits change only when they must: when the data leave them, or fill less than
+    `keep` of them. They are then set so that the data fill `fill` of the view, so a
+    slider moved on in the same direction changes the axes every few steps, not at each
+    (each change of the axes is a full draw of the figure), and never past an artist's
+    sticky edges (matplotlib's ``Artist.sticky_edges``: a time axis that starts at 0 gets
+    ``line.sticky_edges.x.append(0)``). `axis` is ``"y"``, ``"x"`` or ``"both"``. With
+    `min_span`, the view spans at least that much, centred on the data: a response that stays
+    at a constant is drawn flat, not its rounding noise magnified.
     """
+    if axis not in ("x", "y", "both"):
+        raise ValueError(f"axis must be 'x', 'y' or 'both': received {axis!r}.")
+    if not 0 < keep < fill <= 1:
+        raise ValueError(f"fill and keep must satisfy 0 < keep < fill <= 1: received fill={fill!r}, keep={keep!r}.")
+    min_span = as_scalar(min_span, "min_span")
     for ax in axes:
         ax.relim()
-        low, high = ax.dataLim.intervaly
-        if np.isfinite(low) and np.isfinite(high) and high - low < min_span:
-            # widen the data limits, not the view: the axes stays autoscaled (and snapped)
-            middle, x = (low + high) / 2, ax.dataLim.x0
-            ax.update_datalim([(x, middle - min_span / 2), (x, middle + min_span / 2)])
-        ax.autoscale_view()
+        for name in ("xy" if axis == "both" else axis):
+            _fit(ax, name, min_span, fill, keep)
 
 
-def figure_png(fig) -> bytes:
-    """Render a matplotlib figure to PNG bytes, at the figure's dpi (one Agg draw)."""
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    canvas = fig.canvas if isinstance(fig.canvas, FigureCanvasAgg) else FigureCanvasAgg(fig)
-    canvas.draw()
-    return encode_png(canvas.buffer_rgba(), fig.dpi)
+def _fit(ax, name: str, min_span: float, fill: float, keep: float) -> None:
+    """`rescale` for one axis of `ax`, in the axis' scale (decades on a log axis)."""
+    scale = getattr(ax, f"{name}axis").get_transform()
+    with np.errstate(all="ignore"):
+        lo, hi = scale.transform(getattr(ax.dataLim, f"interval{name}"))
+        view = np.sort(scale.transform(getattr(ax, f"get_{name}lim")()))
+    if not (np.isfinite(lo) and np.isfinite(hi)):
+        return                                   # no data yet (or none a log axis can show)
+    if hi - lo < min_span:
+        lo, hi = (lo + hi - min_span) / 2, (lo + hi + min_span) / 2
+    if not hi - lo > 1e-9 * max(abs(lo), abs(hi)):      # a constant: 5 % of it either way (or 0.05)
+        half = 0.05 * (abs(lo) or 1.0)
+        lo, hi = lo - half, hi + half
+    auto = getattr(ax, f"get_autoscale{name}_on")()
+    if auto or lo < view[0] or hi > view[1] or hi - lo < keep * (view[1] - view[0]):
+        pad = (hi - lo) * (1 / fill - 1) / 2
+        low, high = lo - pad, hi + pad
+        with np.errstate(all="ignore"):   # sticky edges: no room past them (a time axis' start)
+            sticky = scale.transform([s for a in ax.get_children() for s in getattr(a.sticky_edges, name)])
+        low = max([low, *(s for s in sticky if low < s <= lo)])
+        high = min([high, *(s for s in sticky if hi <= s < high)])
+        getattr(ax, f"set_{name}lim")(*scale.inverted().transform([low, high]))
 
 
-def _is_slider(widget) -> bool:
-    """A FloatSlider or IntSlider (the controls the browser steps through ahead of the hand)."""
-    import ipywidgets as widgets
-    return isinstance(widget, (widgets.FloatSlider, widgets.IntSlider))
+def format_poles(poles, digits: int = 3) -> str:
+    """Poles (or any complex numbers) as readable text for a readout: "-1, -0.5 ± 2j"; a
+    conjugate pair is written once."""
+    values = sorted(np.atleast_1d(np.asarray(poles, dtype=complex)), key=lambda p: (p.real, -p.imag))
+    out, pending = [], list(values)
+    while pending:
+        p = pending.pop(0)
+        re, im = f"{p.real:.{digits}g}", f"{abs(p.imag):.{digits}g}j"
+        pair = next((q for q in pending if p.imag > 0 and np.isclose(q, np.conj(p))), None)
+        if pair is not None:
+            pending.remove(pair)
+        out.append(re if p.imag == 0 else f"{re} ± {im}" if pair is not None
+                   else f"{re} {'+' if p.imag > 0 else '-'} {im}")
+    return ", ".join(out)
 
 
-def settings_now(controls: dict[str, Any]) -> tuple[dict[str, Any], dict[str, Any]]:
-    """The controls' settings as the browser sees them (a slider's value, a choice's index) and
-    as parameters, each control read once: a front end may change the controls from another
-    thread while a frame is drawn, and a frame must be labelled with the settings it was drawn
-    for."""
-    values, params = {}, {}
-    for name, w in controls.items():
-        if hasattr(w, "index"):
-            values[name], params[name] = w.index, w.value
-        else:
-            values[name] = params[name] = w.value
-    return values, params
-
-
-def requested_params(controls: dict[str, Any], values) -> dict[str, Any] | None:
-    """The parameters for settings `values` the browser asks a frame for, or None when they do
-    not fit: every control named, each slider at a finite number within its range (a whole one
-    for an IntSlider), every other control at its current setting."""
-    if not isinstance(values, dict) or set(values) != set(controls):
-        return None
-    shown, now = settings_now(controls)
-    params = {}
-    for name, w in controls.items():
-        value = values[name]
-        if not _is_slider(w):
-            if value != shown[name]:
-                return None
-            params[name] = now[name]
-            continue
-        if isinstance(value, bool) or not isinstance(value, (int, float)) or not np.isfinite(value):
-            return None
-        if not w.min - 1e-9 * abs(w.step) <= value <= w.max + 1e-9 * abs(w.step):
-            return None
-        if isinstance(w.value, int):
-            if value != int(value):
-                return None
-            value = int(value)
-        params[name] = float(value) if isinstance(w.value, float) else value
-    return params
-
-
-def _fit_scale(natural_px, screen: dict, largest: float = 1.0) -> float:
-    """The factor (at most `largest`) by which a figure of `natural_px` (width, height) fits the
-    reported room."""
-    width, height = (float(screen.get(key) or 0) for key in ("width", "height"))
-    scale = largest
-    if width > 0:
-        scale = min(scale, width / natural_px[0])
-    if height > 0:
-        scale = min(scale, height / natural_px[1])
-    return max(scale, MIN_SCALE)
+def _fit_scale(natural_px, screen: dict, largest: float) -> float:
+    """The factor (at most `largest`) by which a figure of `natural_px` fits the reported room."""
+    room = [float(screen.get(key) or 0) / size for key, size in zip(("width", "height"), natural_px)]
+    return max(min([largest, *(r for r in room if r > 0)]), MIN_SCALE)
 
 
 class Explorer:
-    """A figure whose parameters are set with sliders.
+    """A figure whose parameters are set with sliders and dropdowns.
 
     Parameters
     ----------
     title : str
         Shown above the controls.
     controls : dict of name -> widget
-        Each widget's value is passed to `compute` under its name.
+        Made with `slider`, `int_slider` or `dropdown`; each value is passed to `compute`
+        under its name.
     compute : callable
         ``compute(**params) -> result``; pure, no plotting.
     draw : callable
         ``draw(fig) -> handles``; creates axes and artists on the given figure.
     update : callable
-        ``update(handles, result) -> None``; sets the artists' data.
+        ``update(handles, result) -> None``; sets the artists' data and the view limits.
+    readout : callable, optional
+        ``readout(result) -> str``: the numbers to read, shown next to the controls (a new
+        line for each ``"\\n"``) and part of the figure's text alternative.
     figsize : tuple, optional
-        Natural figure size in inches (shown at the figure's dpi, 100 pixels
-        per inch by default); default from matplotlib's settings. The figure
-        is shown smaller when the screen has less room; in lecture mode it
-        also grows (up to `LECTURE_MAX_SCALE` times) to fill the room.
+        Natural figure size in inches (100 pixels per inch); default from matplotlib's
+        settings. The figure is shown smaller when the screen has less room.
 
-    Attributes
-    ----------
-    frames_ahead : bool
-        Class-wide switch, read when the widget is built: whether the browser asks for the
-        frames of the slider positions next to the current settings while the explorer is on
-        screen (default True). Set ``Explorer.frames_ahead = False`` where the kernel's CPU is
-        scarce; every update is then a round trip to the kernel.
+    A `compute` that fails for the first settings raises ValueError; one that fails for
+    settings a hand moves to leaves the figure as it was and says why in the readout.
     """
 
-    frames_ahead: bool = True
-
     def __init__(self, *, title: str, controls: dict[str, Any], compute: Callable[..., Any],
-                 draw: Callable[[Any], Any], update: Callable[[Any, Any], None], figsize=None):
+                 draw: Callable[[Any], Any], update: Callable[[Any, Any], None],
+                 readout: Callable[[Any], str] | None = None, figsize=None):
         from matplotlib import rcParams
         from matplotlib.figure import Figure
 
-        from ..layout import fit_margins
-        from ..style import is_lecture_mode
-        self.title = title
-        self.controls = dict(controls)
-        self._compute = compute
-        self._update = update
+        from ..style import fit_margins, is_lecture_mode
+        self._check(title, controls, dict(compute=compute, draw=draw, update=update, readout=readout))
+        self.title, self.controls = title, dict(controls)
+        self._compute, self._update, self._readout = compute, update, readout
         self.lecture = is_lecture_mode()
         self.fig = fit_margins(Figure(figsize=figsize or rcParams["figure.figsize"]))
         self.natural_dpi = float(self.fig.dpi)
         self.handles = draw(self.fig)
         self.screen: dict = {}
-        self._shown_values, self._shown_params = settings_now(self.controls)
-        self.result = self._compute(**self._shown_params)
-        # update, then watch the update repeated: the artists it touches are the ones that move
-        self._update(self.handles, self.result)
+        self.error: str | None = None
+        try:
+            self._apply(self.params)
+        except Exception as error:   # noqa: BLE001 - the user's function, named in the message
+            raise ValueError(f"the explorer {title!r} could not show its first settings {self.params}: "
+                             f"{type(error).__name__}: {error}; fix compute/update or the controls' "
+                             "initial values") from error
         self.frames = FrameRenderer(self.fig)
-        self._update(self.handles, self.result)
-        self._cache: OrderedDict = OrderedDict()
         self._png = self.frames.frame()
-        self._remember(self._frame_key(self._shown_params), self.result, self._png)
-        self._widget = None
-        self._view = None
+        self._widget = self._view = self._text = None
+
+    @staticmethod
+    def _check(title, controls, functions: dict) -> None:
+        import ipywidgets as widgets
+        if not isinstance(title, str):
+            raise TypeError(f"title must be a string: received {type(title).__name__}.")
+        if not isinstance(controls, dict) or not controls:
+            raise ValueError("controls must be a non-empty dict of name -> control, e.g. "
+                             "{'k': slider(1.0, 0.0, 5.0, 0.1, 'k [N/m]')}.")
+        for name, w in controls.items():
+            if not isinstance(w, widgets.ValueWidget):
+                raise TypeError(f"controls[{name!r}] must be a control made with slider, int_slider or "
+                                f"dropdown: received {type(w).__name__}.")
+        for name, func in functions.items():
+            if func is not None and not callable(func):
+                raise TypeError(f"{name} must be a function: received {type(func).__name__} {func!r}.")
 
     @property
     def params(self) -> dict[str, Any]:
@@ -247,62 +237,35 @@ class Explorer:
         """The figure as last drawn (PNG bytes, at the size it is shown with)."""
         return self._png
 
-    def refresh(self) -> None:
-        """Recompute for the current control values and redraw the figure.
+    @property
+    def text(self) -> str:
+        """The readout for the settings shown (or why they could not be shown)."""
+        if self.error:
+            return f"No figure for these settings: {self.error}"
+        return self._readout(self.result) if self._readout else ""
 
-        Settings shown before (a slider dragged back over its values) come from a small cache
-        of recent frames, keyed by the settings and the resolution, instead of being computed
-        and drawn again; the figure's artists are still updated, so they always match what is
-        shown.
-        """
-        self._shown_values, self._shown_params = settings_now(self.controls)
-        key = self._frame_key(self._shown_params)
-        cached = self._cache.get(key)
-        if cached is not None:
-            self._cache.move_to_end(key)
-            self.result, self._png = cached
-            self._update(self.handles, self.result)
-            self._send()
-            return
-        self.result = self._compute(**self._shown_params)
-        self._update(self.handles, self.result)
-        self._show()
+    @property
+    def alt(self) -> str:
+        """The figure's text alternative: the title, the settings and the readout."""
+        settings = ", ".join(f"{k} = {v:g}" if isinstance(v, (int, float)) else f"{k} = {v}"
+                             for k, v in self.params.items())
+        return f"{self.title}. Settings: {settings}." + (f" {self.text}" if self.text else "")
 
-    def frame_for(self, params: dict[str, Any]) -> bytes:
-        """The frame (PNG bytes) for the settings `params`, from the cache or computed and
-        drawn, without changing the controls or the frame shown.
-
-        What the browser asks for ahead of the hand. The figure's artists are put back to the
-        settings shown afterwards, so the next frame or `static_png` draws those.
-        """
-        key = self._frame_key(params)
-        cached = self._cache.get(key)
-        if cached is not None:
-            return cached[1]
+    def _apply(self, params: dict) -> None:
         result = self._compute(**params)
+        self._update(self.handles, result)
+        self.result = result
+
+    def refresh(self) -> None:
+        """Recompute for the controls' current values and redraw the figure."""
         try:
-            self._update(self.handles, result)
-            png = self.frames.frame()
-        finally:                     # also when the update or the drawing fails halfway
-            self._update(self.handles, self.result)
-        self._remember(key, result, png)
-        return png
-
-    def forget_frames(self) -> None:
-        """Forget the remembered frames, so that the next `refresh` computes and draws anew
-        (what a benchmark of the redraw times)."""
-        self._cache.clear()
-
-    def _frame_key(self, params: dict[str, Any]):
-        values = tuple((name, float(f"{value:.{KEY_DIGITS}g}") if isinstance(value, float) else value)
-                       for name, value in params.items())
-        return values, self.fig.dpi
-
-    def _remember(self, key, result, png: bytes) -> None:
-        self._cache[key] = (result, png)
-        self._cache.move_to_end(key)
-        while len(self._cache) > FRAME_CACHE_SIZE:
-            self._cache.popitem(last=False)
+            self._apply(self.params)
+            self.error = None
+        except Exception as error:   # noqa: BLE001 - shown to the student; the lecture goes on
+            self.error = f"{type(error).__name__}: {error}"
+        else:
+            self._png = self.frames.frame()
+        self._send()
 
     def static_png(self) -> bytes:
         """The figure for the current settings at its natural size (what a static page shows)."""
@@ -315,92 +278,62 @@ class Explorer:
         self.frames.frame()
         return png
 
-    def _show(self) -> None:
-        """Draw a frame of the figure as it is now, remember it and send it to the view."""
-        self._png = self.frames.frame()
-        self._remember(self._frame_key(self._shown_params), self.result, self._png)
-        self._send()
+    def _readout_html(self) -> str:
+        lines = html.escape(self.text).split("\n")
+        css = "ck-readout ck-error" if self.error else "ck-readout"
+        return f'<div class="{css}">' + "<br>".join(lines) + "</div>"
 
     def _send(self) -> None:
-        if self._view is not None:
-            ratio = float(self.screen.get("ratio") or 1.0)
-            height, width = self.frames.canvas.buffer_rgba().shape[:2]
-            with self._view.hold_sync():
-                self._view.png = self._png
-                self._view.values = self._shown_values
-                self._view.css_width = width / ratio
-                self._view.css_height = height / ratio
-                self._view.alt = self._alt_text()
+        if self._view is None:
+            return
+        ratio = float(self.screen.get("ratio") or 1.0)
+        height, width = self.frames.canvas.get_width_height(physical=True)[::-1]
+        with self._view.hold_sync():
+            self._view.png = self._png
+            self._view.css_width, self._view.css_height = width / ratio, height / ratio
+            self._view.alt = self.alt
+        self._text.value = self._readout_html()
 
     def _on_latest_screen(self) -> None:
-        self._on_screen({"new": self._view.screen})
+        self._on_screen(self._view.screen)
 
-    def _on_screen(self, change) -> None:
+    def _on_screen(self, screen: dict) -> None:
         """Render at the size the figure is shown with: scaled to fit, at the screen's pixel ratio."""
-        self.screen = dict(change["new"] or {})
+        self.screen = dict(screen or {})
         ratio = float(self.screen.get("ratio") or 1.0)
         natural = self.fig.get_size_inches() * self.natural_dpi
         largest = LECTURE_MAX_SCALE if self.lecture else 1.0
         dpi = self.natural_dpi * _fit_scale(natural, self.screen, largest) * ratio
         if abs(dpi - self.fig.dpi) > 1e-6:
             self.fig.set_dpi(dpi)
-            self.forget_frames()         # frames at the old resolution are not shown again
-            if self._view is not None:
-                self._view.generation += 1   # nor those the browser holds
-        self._show()
-
-    def _on_view_msg(self, view, content, buffers) -> None:
-        """Answer the browser's request for a frame ahead of the hand: ``{"type": "frame",
-        "values": ..., "generation": n, "view": id}`` gets the frame (PNG as the message's
-        buffer; values, generation and the asking view's id sent back), or a
-        ``"no-frame"`` reply when the request does not fit the controls or the settings cannot
-        be computed (the browser then asks for other settings; moving a slider there shows the
-        error as usual)."""
-        if not isinstance(content, dict) or content.get("type") != "frame":
-            return
-        reply = {"type": "no-frame", **{key: content.get(key) for key in ("values", "generation", "view")}}
-        params = requested_params(self.controls, content.get("values"))
-        if params is None or content.get("generation") != view.generation:
-            view.send(reply)
-            return
-        try:
-            png = self.frame_for(params)
-        except Exception:   # noqa: BLE001 - the user meets the error when moving there
-            view.send(reply)
-            return
-        view.send({**reply, "type": "frame"}, [png])
-
-    def _settings(self) -> str:
-        return ", ".join(f"{k}={v:g}" if isinstance(v, (int, float)) else f"{k}={v!r}"
-                         for k, v in self._shown_params.items())
-
-    def _alt_text(self) -> str:
-        return f"{self.title} ({self._settings()})"
+            self._png = self.frames.frame()
+        self._send()
 
     @property
     def widget(self):
-        """The live widget: a title, the controls and the figure."""
+        """The live widget: the title, the controls, the readout and the figure."""
         if self._widget is None:
             import ipywidgets as widgets
 
+            from ._home import HomeThread
             from ._view import FigureView
-            self._view = FigureView(png=self._png, alt=self._alt_text(), controls=self.controls,
-                                    values=self._shown_values, ahead=bool(self.frames_ahead),
-                                    css_width=float(self.frames.canvas.buffer_rgba().shape[1]),
-                                    css_height=float(self.frames.canvas.buffer_rgba().shape[0]))
+            width, height = self.frames.canvas.get_width_height(physical=True)
+            self._view = FigureView(png=self._png, alt=self.alt, css_width=float(width),
+                                    css_height=float(height))
+            self._text = widgets.HTML(self._readout_html())
+            self._text.add_class("ck-readout-box")
             # every callback on the kernel's main thread, whichever thread a message arrives on
             home = HomeThread()
             self._view.observe(lambda change: home.run(self._on_latest_screen, key="screen"), names="screen")
-            self._view.on_msg(lambda view, content, buffers: home.run(self._on_view_msg, view, content, buffers))
             for w in self.controls.values():
                 w.observe(lambda change: home.run(self.refresh, key="refresh"), names="value")
-            header = widgets.HTML(f"<b>{self.title}</b>")
+            header = widgets.HTML(f"<b>{html.escape(self.title)}</b>")
             header.add_class("ck-title")
             column = "270px" if self.lecture else "300px"
             boxes = widgets.GridBox(list(self.controls.values()), layout=widgets.Layout(
                 grid_template_columns=f"repeat(auto-fill, minmax({column}, 1fr))", width="100%"))
             boxes.add_class("ck-controls")
-            self._widget = widgets.VBox([header, boxes, self._view])
+            self._widget = widgets.VBox([header, boxes, self._text, self._view])
             self._widget.add_class("ck-explorer")
             if self.lecture:
                 self._widget.add_class("ck-lecture")
@@ -409,7 +342,7 @@ class Explorer:
     def _repr_mimebundle_(self, include=None, exclude=None):
         bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude)
         bundle["image/png"] = base64.b64encode(self.static_png()).decode("ascii")
-        bundle["text/plain"] = f"{self.title} (static figure for {self._settings()})"
+        bundle["text/plain"] = self.alt
         return bundle
 
     def __repr__(self) -> str:

@@ -2,16 +2,13 @@
 
 A front end may hand widget messages to a kernel *subshell*, a second thread of
 the kernel (JupyterLab 4.6 does so by default with ipykernel 7: its setting
-``commsOverSubshells``). A slider moved, a frame asked for ahead of the hand or
-a screen report then reaches the explorer on that thread, while a cell, a
-dropdown change or another explorer draws on the main thread. matplotlib is not
-safe for that: figures and the font cache every figure shares get corrupted
-(garbled or half-drawn frames, "failed to load glyph" errors).
-
-`HomeThread` remembers the thread that built the widget and its running event
-loop (the kernel's main thread and loop, in a notebook cell) and runs each
-callback there: at once when it arrives on that thread, else queued on that
-loop, which runs it between cells. Where no event loop runs (plain Python, the
+``commsOverSubshells``). A slider moved or a screen report then reaches the
+explorer on that thread while a cell, or another explorer, draws on the main
+thread; matplotlib is not safe for that (figures and the font cache they share
+get corrupted: garbled frames, "failed to load glyph" errors). `HomeThread`
+remembers the thread that built the widget and its event loop, and runs each
+callback there: at once when it arrives on that thread, else queued on the
+loop, which runs it between cells. Without a running loop (plain Python, the
 tests) callbacks run where they arrive.
 """
 

@@ -13,7 +13,7 @@ from .._validation import as_integer, as_scalar, time_grid
 from ..realization import euler_discretize
 from ..simulation import simulate
 from ..systems import StateSpace
-from ._base import Explorer, dropdown, rescale, slider
+from ._base import Explorer, dropdown, format_poles, rescale, slider
 
 __all__ = ["EULER_EXAMPLES", "euler_compute", "euler_explorer", "msd_compute", "msd_explorer"]
 
@@ -70,6 +70,7 @@ def euler_explorer() -> Explorer:
         approx, = ax.plot([], [], "o--", markersize=3, linewidth=0.8, color="C1", label="Euler (1.43)")
         err, = ax_err.semilogy([], [], color="C1")
         ax.set_ylabel("x1")
+        ax.set_title("first state: exact and Euler samples")
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
         ax.grid(True, alpha=0.4)
         ax_err.set_ylabel("|x_Euler(k) - x(k Ts)|")
@@ -83,21 +84,26 @@ def euler_explorer() -> Explorer:
         h["approx"].set_marker("o" if r["tk"].size <= 80 else "None")
         # from k = 1 on: at k = 0 both start at x0 and the error is exactly zero
         h["err"].set_data(r["tk"][1:], np.maximum(np.abs(r["xk"] - r["xk_exact"])[1:], 1e-16))
+        # fixed per system: the exact curve with room for the Euler samples near it (samples that
+        # blow up leave the axes; the error plot below shows how far)
         span = max(float(np.ptp(r["x"])), 1e-12)
-        h["ax"].set_xlim(0, r["t"][-1])
+        # a little room before t = 0 keeps the first time label clear of the error axis' lowest one
+        h["ax"].set_xlim(-0.02 * r["t"][-1], r["t"][-1])
         h["ax"].set_ylim(r["x"].min() - 0.5 * span, r["x"].max() + 0.5 * span)
         h["ax"].set_ylabel(f"x1 [{r['unit']}]")
         h["ax_err"].set_ylabel(f"|error| [{r['unit']}]")
         rescale(h["ax_err"])
+
+    def readout(r):
         verdict = "< 1: stable" if r["stable"] else ">= 1: UNSTABLE"
-        h["ax"].set_title(f"{r['example']}, Ts = {r['Ts']:.3g} s, max error {r['max_error']:.2g}\n"
-                          f"max|eig(I + Ts A)| = {r['rho']:.3f} {verdict} (stable if Ts < {r['Ts_max']:.3g})")
+        return (f"{r['example']}, Ts = {r['Ts']:.3g} s: largest error {r['max_error']:.2g} {r['unit']}\n"
+                f"max |eig(I + Ts A)| = {r['rho']:.3f} {verdict} (Euler is stable for Ts < {r['Ts_max']:.3g} s)")
 
     return Explorer(
         title="Euler discretization (1.43): step Ts against the exact solution",
         controls=dict(Ts=slider(0.1, 0.01, 1.0, 0.01, "Ts [s]"),
                       example=dropdown(list(EULER_EXAMPLES), "first order (1.12)", "system")),
-        compute=euler_compute, draw=draw, update=update, figsize=(8, 5.5))
+        compute=euler_compute, draw=draw, update=update, readout=readout, figsize=(8, 5.5))
 
 
 def msd_compute(m: float, d: float, k: float, experiment: str = "step", t_end: float = 20.0,
@@ -135,6 +141,7 @@ def msd_explorer() -> Explorer:
         v, = ax.plot([], [], label="velocity y' [m/s]")
         ax.set_xlabel("time t [s]")
         ax.set_ylabel("y [m], y' [m/s]")
+        ax.set_title("response")
         ax.legend(loc="best", fontsize="small")
         ax.grid(True, alpha=0.4)
         poles, = ax_p.plot([], [], "x", markersize=10, markeredgewidth=2, color="C3")
@@ -144,20 +151,21 @@ def msd_explorer() -> Explorer:
         ax_p.set_ylabel("Im s [rad/s]")
         ax_p.set_title("poles = eig(A)")
         ax_p.grid(True, alpha=0.4)
-        title = fig.suptitle("")
-        return dict(ax=ax, ax_p=ax_p, y=y, v=v, poles=poles, title=title)
+        return dict(ax=ax, ax_p=ax_p, y=y, v=v, poles=poles)
 
     def update(h, r):
         h["y"].set_data(r["t"], r["y"])
         h["v"].set_data(r["t"], r["v"])
         h["poles"].set_data(r["poles"].real, r["poles"].imag)
-        rescale(h["ax"], h["ax_p"])
-        lim = 1.2 * max(1.0, float(np.abs(r["poles"]).max()))
-        h["ax_p"].set_xlim(-lim, 0.3 * lim)
-        h["ax_p"].set_ylim(-lim, lim)
-        h["title"].set_text(f"{r['experiment']} response, m = {r['m']:g} kg, d = {r['d']:g} N s/m, "
-                            f"k = {r['k']:g} N/m: damping ratio zeta = {r['zeta']:.3f}, "
-                            f"natural frequency omega_n = {r['omega_n']:.3f} rad/s")
+        h["ax"].set_xlim(0, r["t"][-1])
+        rescale(h["ax"])
+        rescale(h["ax_p"], axis="both", min_span=1.0)
+
+    def readout(r):
+        poles = format_poles(r["poles"])
+        return (f"{r['experiment']} response, m = {r['m']:g} kg, d = {r['d']:g} N s/m, k = {r['k']:g} N/m\n"
+                f"damping ratio zeta = {r['zeta']:.3f}, natural frequency omega_n = {r['omega_n']:.3f} rad/s, "
+                f"poles {poles} 1/s")
 
     return Explorer(
         title="Mass-spring-damper (1.54): parameters m, d, k against the response",
@@ -165,4 +173,4 @@ def msd_explorer() -> Explorer:
                       d=slider(0.5, 0.0, 5.0, 0.05, "d [N s/m]"),
                       k=slider(2.0, 0.1, 10.0, 0.1, "k [N/m]"),
                       experiment=dropdown(["step", "initial"], "step", "experiment")),
-        compute=msd_compute, draw=draw, update=update, figsize=(11, 4.5))
+        compute=msd_compute, draw=draw, update=update, readout=readout, figsize=(11, 4.5))

@@ -73,6 +73,9 @@ def planner_explorer() -> Explorer:
         ax_u.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
         ax_u.grid(True, alpha=0.4)
         marks = [ax.axvline(0, color="0.5", linestyle=":") for ax in (ax_y, ax_u)]
+        ax_y.set_title("planned and simulated position (dotted: the horizon T)")
+        for line in (yd, y, ud):
+            line.sticky_edges.x.append(0.0)    # time starts at 0: no room before it
         return dict(ax_y=ax_y, ax_u=ax_u, yd=yd, y=y, ud=ud, marks=marks)
 
     def update(h, r):
@@ -82,8 +85,11 @@ def planner_explorer() -> Explorer:
         for line in h["marks"]:
             line.set_xdata([r["T"], r["T"]])
         rescale(h["ax_y"], h["ax_u"])
-        h["ax_y"].set_title(f"degree {2 * r['r'] - 1} move to {r['target']:g} m in T = {r['T']:g} s, mass error "
-                            f"{r['mass_error']:g} %: |y(T) - target| = {r['end_error']:.2g} m")
+        rescale(h["ax_u"], axis="x")          # the shared time axis [0, 2 T], from 0 on
+
+    def readout(r):
+        return (f"degree {2 * r['r'] - 1} move to {r['target']:g} m in T = {r['T']:g} s, "
+                f"mass error {r['mass_error']:g} %\n|y(T) - target| = {r['end_error']:.2g} m")
 
     return Explorer(
         title="Trajectory planner (2.30), (2.40): mass-spring-damper m = 1 kg, d = 0.5 N s/m, k = 2 N/m",
@@ -91,7 +97,7 @@ def planner_explorer() -> Explorer:
                       target=slider(1.0, -2.0, 2.0, 0.1, "target y(T) [m]"),
                       mass_error=slider(0.0, -30.0, 30.0, 1.0, "mass error [%]"),
                       r=int_slider(2, 2, 4, "boundary conditions r")),
-        compute=planner_compute, draw=draw, update=update, figsize=(9, 6))
+        compute=planner_compute, draw=draw, update=update, readout=readout, figsize=(9, 6))
 
 
 def robot_planner_compute(x_T: float = 4.0, y_T: float = 2.0, heading_deg: float = 90.0,
@@ -183,10 +189,13 @@ def robot_planner_explorer() -> Explorer:
         ax.set_xlabel("x1 [m]")
         ax.set_ylabel("x2 [m]")
         ax.set_aspect("equal", adjustable="datalim")
+        ax.set_title("path in the plane")
         ax.legend(loc="best", fontsize="small")
         ax.grid(True, alpha=0.4)
         u1, = ax_u.plot([], [], label="speed u1 [m/s]")
         u2, = ax_u.plot([], [], label="turn rate u2 [rad/s]")
+        for line in (u1, u2):
+            line.sticky_edges.x.append(0.0)    # time starts at 0: no room before it
         ax_u.set_xlabel("time t [s]")
         ax_u.set_ylabel("u1 [m/s], u2 [rad/s]")
         ax_u.set_title("inputs psi_u (2.102)")
@@ -203,7 +212,7 @@ def robot_planner_explorer() -> Explorer:
         tu = r["t"][:r["u"].shape[0]]
         h["u1"].set_data(tu, r["u"][:, 0])
         h["u2"].set_data(tu, r["u"][:, 1])
-        h["ax_u"].relim()
+        rescale(h["ax_u"], axis="both")
         # the data limits of the path axes from its points, start and target: not relim(), which
         # in newer matplotlib counts the arrow at a place that moves with the view, so the view
         # would widen at every update
@@ -212,10 +221,12 @@ def robot_planner_explorer() -> Explorer:
         tip = _arrow_tip(points, tx, ty, th)
         h["shaft"].set_data(np.linspace(tx, tip[0, 0], 20), np.linspace(ty, tip[0, 1], 20))
         h["ax"].update_datalim(np.vstack([points, tip]))
-        for ax in (h["ax"], h["ax_u"]):
-            ax.autoscale_view()
-        h["ax"].set_title(f"two-wheeled robot to ({tx:g} m, {ty:g} m, {np.rad2deg(th):g} deg) "
-                          f"in {r['T']:g} s\n{r['message']}")
+        h["ax"].autoscale_view()
+
+    def readout(r):
+        tx, ty, th = r["target"]
+        return (f"two-wheeled robot to ({tx:g} m, {ty:g} m, {np.rad2deg(th):g} deg) in {r['T']:g} s\n"
+                f"{r['message']}")
 
     return Explorer(
         title="Two-wheeled robot planner (2.94)-(2.102): flat outputs F = (x1, x2)",
@@ -224,4 +235,4 @@ def robot_planner_explorer() -> Explorer:
                       heading_deg=slider(90.0, -180.0, 180.0, 15.0, "target heading [deg]"),
                       T=slider(6.0, 1.0, 20.0, 0.5, "horizon T [s]"),
                       speed=slider(1.0, -2.0, 2.0, 0.1, "end speed [m/s]")),
-        compute=robot_planner_compute, draw=draw, update=update, figsize=(11, 5))
+        compute=robot_planner_compute, draw=draw, update=update, readout=readout, figsize=(11, 5))

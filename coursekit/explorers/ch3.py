@@ -17,7 +17,7 @@ from ..linearization import linearize
 from ..placement import place
 from ..simulation import simulate, simulate_batch
 from ..systems import StateSpace
-from ._base import Explorer, rescale, slider
+from ._base import Explorer, format_poles, rescale, slider
 
 __all__ = [
     "pair_poles",
@@ -90,7 +90,7 @@ def pole_placement_explorer() -> Explorer:
         # below the figure, where it hides no pole whatever the sliders say
         fig.legend(handles=[stable, ol, cl], loc="outside lower center", ncols=3, fontsize="small")
         xs = [ax_x.plot([], [], label=f"x{i + 1}")[0] for i in range(3)]
-        ax_x.set(xlabel="time t [s]", ylabel="state x (dimensionless)")
+        ax_x.set(xlabel="time t [s]", ylabel="state x (dimensionless)", title="response from x0 = [1, 0, 0]")
         ax_x.legend(loc="best", fontsize="small")
         u, = ax_u.plot([], [], color="C4", label="u = K x")
         ax_u.set(xlabel="time t [s]", ylabel="control effort u", title="control effort u(t)")
@@ -106,16 +106,21 @@ def pole_placement_explorer() -> Explorer:
         for i, line in enumerate(h["xs"]):
             line.set_data(r["t"], r["x"][:, i])
         h["u"].set_data(r["t"], r["u"])
+        for ax in (h["ax_x"], h["ax_u"]):
+            ax.set_xlim(0, r["t"][-1])
         rescale(h["ax_x"], h["ax_u"])
-        h["ax_x"].set_title(f"response from x0 = [1, 0, 0]\n{_gain_text(r['K'])}")
-        h["ax_u"].set_title(f"control effort u(t)\nmax |u| = {r['max_u']:.3g}")
+
+    def readout(r):
+        return (f"{_gain_text(r['K'])}, max |u| = {r['max_u']:.3g}\n"
+                f"closed-loop poles eig(A + B K) = {format_poles(r['achieved'])}; "
+                f"open loop eig(A) = {format_poles(r['open_loop'])}")
 
     return Explorer(
         title="Pole placement (3.46)-(3.47) for the plant (3.22) driven by u1 only",
         controls=dict(wn=slider(2.0, 0.5, 6.0, 0.25, "pair: natural frequency wn [rad/s]"),
                       zeta=slider(0.7, 0.1, 2.0, 0.05, "pair: damping ratio zeta"),
                       p3=slider(-3.0, -10.0, -0.5, 0.25, "real pole p3 [1/s]")),
-        compute=pole_placement_compute, draw=draw, update=update, figsize=(13, 4.5))
+        compute=pole_placement_compute, draw=draw, update=update, readout=readout, figsize=(13, 4.5))
 
 
 def _saturated(ctrl, u_max: float):
@@ -188,7 +193,7 @@ def upright_pendulum_explorer() -> Explorer:
         lin, = ax_th.plot([], [], color="C0", label="linear u = K(x - x*) (3.92)")
         fl, = ax_th.plot([], [], color="C1", ls="--", label="feedback linearizing (3.154)")
         ax_th.axhline(0, color="0.5", lw=0.8)
-        ax_th.set(xlabel="time t [s]", ylabel="theta - pi [deg]")
+        ax_th.set(xlabel="time t [s]", ylabel="theta - pi [deg]", title="angle from upright")
         ulin, = ax_u.plot([], [], color="C0")
         ufl, = ax_u.plot([], [], color="C1", ls="--")
         ax_u.set(xlabel="time t [s]", ylabel="torque u [N m]", title="control torque")
@@ -203,18 +208,22 @@ def upright_pendulum_explorer() -> Explorer:
         h["fl"].set_data(r["t"], r["dev_fl"])
         h["ulin"].set_data(r["t"], r["u_linear"])
         h["ufl"].set_data(r["t"], r["u_fl"])
+        for ax in (h["ax_th"], h["ax_u"]):
+            ax.set_xlim(0, r["t"][-1])
         rescale(h["ax_th"], min_span=2.0)     # degrees: started upright, it stays there
         rescale(h["ax_u"], min_span=0.2)      # N m
+
+    def readout(r):
         verdict = lambda ok: "upright" if ok else "NOT upright"  # noqa: E731
-        h["ax_th"].set_title(f"start {r['theta0_deg']:g} deg from upright, |u| <= {r['u_max']:g} N m\n"
-                             f"linear: {verdict(r['linear_ok'])}, feedback linearizing: {verdict(r['fl_ok'])}")
+        return (f"start {r['theta0_deg']:g} deg from upright, |u| <= {r['u_max']:g} N m, K = {_gain_text(r['K'])[4:]}\n"
+                f"linear: {verdict(r['linear_ok'])}, feedback linearizing: {verdict(r['fl_ok'])}")
 
     return Explorer(
         title="Upright pendulum (m = l = 1, g = 9.81): linear feedback vs feedback linearization",
         controls=dict(theta0_deg=slider(30.0, -180.0, 180.0, 5.0, "initial angle from upright [deg]"),
                       pole=slider(-2.0, -6.0, -0.5, 0.25, "closed-loop poles [pole, pole - 1]"),
                       u_max=slider(50.0, 2.0, 60.0, 1.0, "torque limit |u| <= [N m]")),
-        compute=upright_pendulum_compute, draw=draw, update=update, figsize=(12, 4.5))
+        compute=upright_pendulum_compute, draw=draw, update=update, readout=readout, figsize=(12, 4.5))
 
 
 def integral_action_compute(d: float = 1.0, integral_pole: float = -1.0, t_end: float = 12.0,
@@ -260,7 +269,7 @@ def integral_action_explorer() -> Explorer:
         integ, = ax_y.plot([], [], color="C2", label="with integral action u = K x + k_I int x1 (3.117)")
         off = ax_y.axhline(0, color="C0", ls=":", label="predicted offset (3.109)")
         ax_y.axvline(1.0, color="0.5", ls="--", lw=0.8)
-        ax_y.set(xlabel="time t [s]", ylabel="output y = x1")
+        ax_y.set(xlabel="time t [s]", ylabel="output y = x1", title="output after the disturbance (dashed: t = 1 s)")
         uplain, = ax_u.plot([], [], color="C0")
         uint, = ax_u.plot([], [], color="C2")
         ax_u.set(xlabel="time t [s]", ylabel="control input u", title="control input (integral action ends at u = -d)")
@@ -282,11 +291,14 @@ def integral_action_explorer() -> Explorer:
         h["ax_u"].set_xlim(r["t"][0], r["t"][-1])
         h["ax_y"].set_ylim(-d_max * r["y_per_d"], d_max * r["y_per_d"])
         h["ax_u"].set_ylim(-d_max * r["u_per_d"], d_max * r["u_per_d"])
-        h["ax_y"].set_title(f"step disturbance d = {r['d']:g} at t = 1 s\n"
-                            f"K_E = [{', '.join(f'{k:.3g}' for k in r['K_E'][0])}]")
+
+    def readout(r):
+        return (f"step disturbance d = {r['d']:g} at t = 1 s: offset of plain feedback {r['offset']:.3g}\n"
+                f"K = [{', '.join(f'{k:.3g}' for k in r['K'][0])}], "
+                f"K_E = [{', '.join(f'{k:.3g}' for k in r['K_E'][0])}]")
 
     return Explorer(
         title="Integral action (3.110)-(3.120) on the CCF (3.27), a0 = 6, a1 = -5",
         controls=dict(d=slider(1.0, -INTEGRAL_D_MAX, INTEGRAL_D_MAX, 0.1, "disturbance d"),
                       integral_pole=slider(-1.0, -6.0, -0.2, 0.1, "integral pole [1/s]")),
-        compute=integral_action_compute, draw=draw, update=update, figsize=(12, 4.5))
+        compute=integral_action_compute, draw=draw, update=update, readout=readout, figsize=(12, 4.5))

@@ -18,7 +18,7 @@ from ..kalman import kalman_gain, simulate_with_noise, white_noise
 from ..observability import place_observer
 from ..observers import observer_system
 from ..simulation import simulate
-from ._base import Explorer, rescale, slider
+from ._base import Explorer, format_poles, rescale, slider
 
 __all__ = ["KALMAN_TRUE_Q", "KALMAN_TRUE_R", "observer_noise_compute", "observer_noise_explorer", "kalman_tuning_compute",
            "kalman_tuning_explorer"]
@@ -73,14 +73,16 @@ def observer_noise_compute(speed: float, noise_std: float, *, seed: int = 0, t_e
                 poles=np.linalg.eigvals(sys.A - L @ sys.C), rms_late=_rms(err[half:]), settle=settle)
 
 
-def _two_state_axes(fig, measured_label: str):
+def _two_state_axes(fig):
+    """Position (with the noisy GPS samples) above velocity: truth and estimate."""
     ax_p, ax_v = fig.subplots(2, 1, sharex=True)
-    meas, = ax_p.plot([], [], ".", markersize=2, color="0.6", label=measured_label)
+    meas, = ax_p.plot([], [], ".", markersize=2, color="0.6", label="GPS y (noisy)")
     true_p, = ax_p.plot([], [], "k", linewidth=1.5, label="true position x1")
     est_p, = ax_p.plot([], [], color="C1", linewidth=1.2, label="estimate x̂1")
     true_v, = ax_v.plot([], [], "k", linewidth=1.5, label="true velocity x2")
     est_v, = ax_v.plot([], [], color="C1", linewidth=1.2, label="estimate x̂2")
     ax_p.set_ylabel("position [m]")
+    ax_p.set_title("true state and estimate")
     ax_v.set_ylabel("velocity [m/s]")
     ax_v.set_xlabel("time t [s]")
     for ax in (ax_p, ax_v):
@@ -106,22 +108,18 @@ def _set_two_state(h, r):
 
 def observer_noise_explorer() -> Explorer:
     """Sliders for the observer pole and the GPS noise: fast observers amplify noise."""
-    def draw(fig):
-        return _two_state_axes(fig, "GPS y (noisy)")
-
-    def update(h, r):
-        _set_two_state(h, r)
+    def readout(r):
         L = r["L"].ravel()
-        h["ax_p"].set_title(
-            f"observer poles at {-r['speed']:.3g} (double), L = [{L[0]:.3g}, {L[1]:.3g}]; "
-            f"error below 5 % after {r['settle']:.2g} s\nRMS error (2nd half): "
-            f"position {r['rms_late'][0]:.3g} m, velocity {r['rms_late'][1]:.3g} m/s")
+        return (f"observer poles {format_poles(r['poles'])}, L = [{L[0]:.3g}, {L[1]:.3g}]; "
+                f"error below 5 % after {r['settle']:.2g} s\n"
+                f"RMS error over the second half: position {r['rms_late'][0]:.3g} m, "
+                f"velocity {r['rms_late'][1]:.3g} m/s")
 
     return Explorer(
         title="Observer speed vs measurement noise (4.25)-(4.27): vehicle with GPS",
         controls=dict(speed=slider(2.0, 0.2, 20.0, 0.2, "observer pole -s, s [rad/s]"),
                       noise_std=slider(0.05, 0.0, 0.3, 0.01, "GPS noise std [m]")),
-        compute=observer_noise_compute, draw=draw, update=update, figsize=(8, 6))
+        compute=observer_noise_compute, draw=_two_state_axes, update=_set_two_state, readout=readout, figsize=(8, 6))
 
 
 #: The true noise intensities of the Kalman explorer's data: force noise on the
@@ -184,18 +182,12 @@ def _log_slider(true_value: float, low: float, high: float, description: str, st
 
 def kalman_tuning_explorer() -> Explorer:
     """Sliders for log10 Q and log10 R of a Kalman observer on the same noisy data."""
-    def draw(fig):
-        return _two_state_axes(fig, "GPS y (noisy)")
-
-    def update(h, r):
-        _set_two_state(h, r)
-        poles = ", ".join(f"{p:.2g}" for p in np.sort_complex(r["poles"]))
-        h["ax_p"].set_title(
-            f"Q = diag(0, {r['q']:.2g}), R = {r['r']:.2g}: eig(A - LC) = {poles}\n"
-            f"RMS velocity error {r['rms'][1]:.3g} m/s (matched Q, R: {r['rms_matched'][1]:.3g} m/s)")
+    def readout(r):
+        return (f"Q = diag(0, {r['q']:.2g}), R = {r['r']:.2g}: eig(A - L C) = {format_poles(r['poles'], 2)}\n"
+                f"RMS velocity error {r['rms'][1]:.3g} m/s (with the true Q, R: {r['rms_matched'][1]:.3g} m/s)")
 
     return Explorer(
         title="Kalman filter tuning (4.87)-(4.88): only Q/R matters",
         controls=dict(log10_q=_log_slider(KALMAN_TRUE_Q, -4.0, 3.0, "log10 Q (velocity)"),
                       log10_r=_log_slider(KALMAN_TRUE_R, -6.0, 0.0, "log10 R (GPS)")),
-        compute=kalman_tuning_compute, draw=draw, update=update, figsize=(8, 6))
+        compute=kalman_tuning_compute, draw=_two_state_axes, update=_set_two_state, readout=readout, figsize=(8, 6))
