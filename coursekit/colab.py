@@ -18,13 +18,14 @@ import re
 import subprocess
 from pathlib import Path
 
+from .cells import ENVIRONMENT, INSTALL, ROLE_KEY, role
 from .release import notebook_paths, read_notebook, write_notebook
 
 __all__ = ["INSTALL_MARK", "install_cell_source", "cell_repository", "with_install_cell",
            "apply_install_cell", "repository_from_git"]
 
 #: the cell metadata ``coursekit`` value that marks the install cell
-INSTALL_MARK = "install"
+INSTALL_MARK = INSTALL
 
 _HEADER = ("# Colab and other hosted notebooks start without coursekit: this cell installs it there.\n"
            "# Where coursekit is installed (your own JupyterLab, Binder, CI) it does nothing.\n")
@@ -62,7 +63,7 @@ def cell_repository(source: str) -> str | None:
 
 def _install_cell_index(nb) -> int | None:
     for index, cell in enumerate(nb.cells):
-        if cell.get("metadata", {}).get("coursekit") == INSTALL_MARK:
+        if role(cell) == INSTALL_MARK:
             return index
     return None
 
@@ -80,11 +81,11 @@ def with_install_cell(nb, *, repository: str | None = None):
     if index is not None:
         nb.cells[index].source = source
         return nb
-    cell = nbformat.v4.new_code_cell(source, metadata={"coursekit": INSTALL_MARK})
+    cell = nbformat.v4.new_code_cell(source, metadata={ROLE_KEY: INSTALL_MARK})
     # before the environment check (its text and code cell), else before the first code cell
-    marks = [c.get("metadata", {}).get("coursekit") for c in nb.cells]
+    marks = [role(c) for c in nb.cells]
     kinds = [c.cell_type for c in nb.cells]
-    at = marks.index("environment") if "environment" in marks else (
+    at = marks.index(ENVIRONMENT) if ENVIRONMENT in marks else (
         kinds.index("code") if "code" in kinds else len(nb.cells))
     nb.cells.insert(at, cell)
     return nb

@@ -28,8 +28,9 @@ import copy
 import re
 from pathlib import Path
 
+from .cells import EXERCISE, is_solution, role
+
 __all__ = [
-    "SOLUTION_TAG",
     "STUDENT_NOTE",
     "student_edition",
     "build_release",
@@ -39,8 +40,6 @@ __all__ = [
     "write_notebook",
 ]
 
-#: the cell tag that marks a worked solution
-SOLUTION_TAG = "solution"
 
 #: appended to the first cell of every notebook of the student edition
 STUDENT_NOTE = ("> **Student edition.** The worked solutions of the exercises are not in this copy: "
@@ -99,7 +98,7 @@ def write_notebook(nb, path: Path | str) -> None:
 
 
 def _is_solution(cell) -> bool:
-    return SOLUTION_TAG in cell.get("metadata", {}).get("tags", [])
+    return is_solution(cell)
 
 
 def _without_solution_pointers(text: str) -> str:
@@ -144,7 +143,7 @@ def student_edition(nb):
         if cell.cell_type == "code":
             cell.outputs = []
             cell.execution_count = None
-        elif cell.cell_type == "markdown" and cell.get("metadata", {}).get("coursekit") == "exercise":
+        elif cell.cell_type == "markdown" and role(cell) == EXERCISE:
             cell.source = _without_solution_pointers(cell.source)
     nb.metadata.pop("widgets", None)
     _add_note(nb)

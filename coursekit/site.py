@@ -32,9 +32,11 @@ import sys
 import tempfile
 from pathlib import Path
 
+from .cells import is_solution
+from .chapters import chapter_notebooks
+
 __all__ = [
     "build_site",
-    "chapter_notebooks",
     "erratum_admonitions",
     "fold_solution_code",
     "strip_widget_views",
@@ -89,19 +91,6 @@ def missing_site_tools() -> list[str]:
             if importlib.util.find_spec(module) is None]
 
 
-def chapter_notebooks(notebooks_dir) -> list[Path]:
-    """The chapter notebooks (``01_*.ipynb``, ``02_*.ipynb``, ...) of `notebooks_dir`, in order."""
-    folder = Path(notebooks_dir)
-    if not folder.is_dir():
-        raise ValueError(f"notebooks_dir {str(folder)!r} is not a directory; pass the folder "
-                         "that holds the chapter notebooks (notebooks/ in the repository)")
-    found = sorted(p for p in folder.glob("[0-9]*.ipynb") if p.is_file())
-    if not found:
-        raise ValueError(f"notebooks_dir {str(folder)!r} holds no chapter notebook "
-                         "(files named like 01_representations.ipynb)")
-    return found
-
-
 def strip_widget_views(nb):
     """Remove the widget views from every output of `nb` (in place) and return `nb`.
 
@@ -134,7 +123,7 @@ def fold_solution_code(nb):
     for cell in nb.cells:
         metadata = cell.setdefault("metadata", {})
         tags = metadata.get("tags", [])
-        if cell.get("cell_type") == "code" and "solution" in tags:
+        if cell.get("cell_type") == "code" and is_solution(cell):
             metadata["tags"] = [*tags, "hide-cell"] if "hide-cell" not in tags else tags
             metadata["mystnb"] = {**metadata.get("mystnb", {}),
                                   "code_prompt_show": "Show solution",

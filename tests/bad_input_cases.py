@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import contextlib
 import faulthandler
+import inspect
 import io
 import json
 import re
@@ -42,6 +43,7 @@ import coursekit as ck
 import coursekit.exercises as ex
 from coursekit.exercises._feedback import CheckResult
 from coursekit import models
+from coursekit.chapters import check_functions
 from coursekit.explorers import ch1 as xp1, ch2 as xp2, ch3 as xp3, ch4 as xp4
 
 #: seconds a single case may take before it counts as a hang (the slowest good case
@@ -769,14 +771,9 @@ bad("explorers.kalman_tuning_compute", "seed text", lambda: xp4.kalman_tuning_co
 # ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"
 
-_EXERCISE_ARGS = {  # a check and the number of answers it takes
-    "check_msd_state_space": 3, "check_compartment_state_space": 3, "check_ode_realization": 3,
-    "check_euler_discretization": 2, "check_ctrb_matrix": 1, "check_ccf_transform": 1,
-    "check_car_flatness": 2, "check_trajectory_coefficients": 1, "check_gain_ccf": 1,
-    "check_gain_general": 1, "check_pendulum_linearization": 2, "check_obsv_matrix": 1,
-    "check_observer_gain": 1, "check_separation_poles": 1, "check_stability": 1,
-    "check_kalman_decision": 2, "check_vehicle_observability": 2, "check_pendulum_f": 1,
-}
+#: every check of the course (a new chapter's too) and the number of answers it takes
+_EXERCISE_ARGS = {label.split(".")[1]: len(inspect.signature(check).parameters)
+                  for label, check in check_functions().items()}
 for _check, _count in _EXERCISE_ARGS.items():
     # the feedback names the problem; for a list of poles or of True/False answers a complex
     # 2x2 matrix is first of all the wrong number of entries

@@ -23,9 +23,8 @@ import pytest
 
 import bad_input_cases as table
 import coursekit as ck
-import coursekit.exercises as ex
 from coursekit import models
-from coursekit.explorers import ch1, ch2, ch3, ch4
+from coursekit.chapters import chapter_modules, check_functions
 
 WORKER = Path(table.__file__)
 #: a worker that prints nothing for this long is stuck outside any case's deadline
@@ -125,8 +124,8 @@ def test_every_public_function_and_class_has_bad_input_cases():
     covered |= {target.split(".")[0] for target in covered}  # a class is covered by its methods' cases
     wanted = _public(ck) - NOT_CALLED_BY_STUDENTS
     wanted |= _public(models, "models.")
-    wanted |= {f"exercises.{name}" for name in ex.__all__ if name.startswith("check_")}
-    wanted |= {f"explorers.{name}" for module in (ch1, ch2, ch3, ch4) for name in module.__all__
+    wanted |= {"exercises." + label.split(".")[1] for label in check_functions()}
+    wanted |= {f"explorers.{name}" for module in chapter_modules("explorers") for name in module.__all__
                if inspect.isfunction(getattr(module, name)) and not name.endswith("_explorer")}
     # methods students call
     wanted |= {"StateSpace.f", "StateSpace.h", "StateSpace.poles", "NonlinearSystem.f",

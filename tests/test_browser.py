@@ -36,6 +36,7 @@ import numpy as np
 import pytest
 
 import lab_harness as lab_h
+from coursekit.chapters import chapter_notebooks
 
 pytestmark = pytest.mark.browser
 
@@ -94,7 +95,7 @@ IDLE_S = 8                   # how long the kernel is watched while nobody touch
 
 
 def _chapter_notebooks() -> list[str]:
-    return sorted(p.name for p in NOTEBOOKS.glob("0*.ipynb"))
+    return [p.name for p in chapter_notebooks(NOTEBOOKS)]
 
 
 @pytest.fixture(scope="module")

@@ -25,9 +25,10 @@ from pathlib import Path
 
 import pytest
 
+from coursekit.chapters import chapter_notebooks
 from coursekit.exercises._feedback import CheckResult
 
-NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("0*.ipynb"))
+NOTEBOOKS = chapter_notebooks(Path(__file__).resolve().parents[1] / "notebooks")
 SUMMARY = "Solution (try the exercise first)"
 SOLUTION = re.compile(r"<details><summary>(?P<summary>[^<]*)</summary>\n\n```python\n(?P<code>.*?)\n```\n\n"
                       r"</details>", re.S)

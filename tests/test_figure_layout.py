@@ -17,7 +17,8 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import coursekit as ck  # noqa: E402
-from coursekit.explorers import ch1, ch2, ch3, ch4  # noqa: E402
+from coursekit.chapters import explorer_factories  # noqa: E402
+from coursekit.explorers import ch1  # noqa: E402
 from layout_check import legend_problems, text_problems  # noqa: E402
 
 #: a legend inside its axes may hide at most this fraction of the points of a curve
@@ -128,10 +129,8 @@ def test_plotting_helper_figure_has_no_text_problems(name, style_name):
 
 # --- the explorers --------------------------------------------------------------------------
 
-EXPLORERS = {f.__name__: f for f in (
-    ch1.euler_explorer, ch1.msd_explorer, ch2.planner_explorer, ch2.robot_planner_explorer,
-    ch3.pole_placement_explorer, ch3.upright_pendulum_explorer, ch3.integral_action_explorer,
-    ch4.observer_noise_explorer, ch4.kalman_tuning_explorer)}
+#: every explorer of the course (a new chapter's too)
+EXPLORERS = {f.__name__: f for f in explorer_factories().values()}
 
 
 def settings(controls, *, every_end: bool):

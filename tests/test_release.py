@@ -16,7 +16,8 @@ import nbformat
 import pytest
 
 from coursekit.__main__ import main
-from coursekit.release import (SOLUTION_TAG, STUDENT_NOTE, build_release, default_notebook_dir,
+from coursekit.cells import SOLUTION_TAG
+from coursekit.release import (STUDENT_NOTE, build_release, default_notebook_dir,
                                read_notebook, student_edition)
 
 NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))

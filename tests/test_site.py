@@ -17,6 +17,7 @@ import nbformat
 import pytest
 
 from coursekit import site
+from coursekit.chapters import chapter_notebooks
 from coursekit.__main__ import main
 
 NOTEBOOKS = Path(__file__).parents[1] / "notebooks"
@@ -146,12 +147,12 @@ def test_landing_page_has_a_row_and_a_toctree_entry_per_chapter():
 
 
 def test_chapter_notebooks_are_found_in_order_and_bad_folders_refused(tmp_path):
-    assert [p.name for p in site.chapter_notebooks(NOTEBOOKS)][:2] == [
+    assert [p.name for p in chapter_notebooks(NOTEBOOKS)][:2] == [
         "01_representations.ipynb", "02_controllability.ipynb"]
     with pytest.raises(ValueError, match="not a directory"):
-        site.chapter_notebooks(tmp_path / "missing")
+        chapter_notebooks(tmp_path / "missing")
     with pytest.raises(ValueError, match="no chapter notebook"):
-        site.chapter_notebooks(tmp_path)
+        chapter_notebooks(tmp_path)
 
 
 @pytest.mark.parametrize("kwargs, error, match", [

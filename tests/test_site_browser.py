@@ -26,13 +26,14 @@ import nbformat
 import pytest
 
 from coursekit import site
+from coursekit.chapters import chapter_notebooks
 
 import lab_harness  # the browser test's Chromium location and settings
 
 pytestmark = pytest.mark.browser
 
 NOTEBOOKS = Path(__file__).parents[1] / "notebooks"
-CHAPTERS = [p.stem for p in site.chapter_notebooks(NOTEBOOKS)]
+CHAPTERS = [p.stem for p in chapter_notebooks(NOTEBOOKS)]
 PAGES = ["index", *CHAPTERS, "genindex", "search"]
 EDITIONS = ["instructor", "student"]
 ERRATUM_BACKGROUND = "rgb(255, 247, 237)"   # coursekit.site.CSS, light mode

@@ -1,0 +1,62 @@
+"""The course's chapters, found rather than listed.
+
+A chapter is a notebook ``NN_name.ipynb`` in ``notebooks/`` and, when it has them, a module
+``chN`` in `coursekit.explorers` (its explorers: public functions named ``*_explorer``) and
+one in `coursekit.exercises` (its exercises: public functions named ``check_*``). The tests,
+the benchmarks, the release, the website and the slides take the chapters from here, so a
+fifth chapter is picked up by all of them without an edit.
+"""
+
+from __future__ import annotations
+
+import importlib
+import inspect
+import pkgutil
+import re
+from pathlib import Path
+from typing import Callable
+
+__all__ = ["chapter_modules", "explorer_factories", "check_functions", "chapter_notebooks"]
+
+
+def chapter_modules(package: str) -> list:
+    """The modules ``chN`` of `package` (``"explorers"`` or ``"exercises"``), by N."""
+    if package not in ("explorers", "exercises"):
+        raise ValueError(f"package must be 'explorers' or 'exercises': received {package!r}.")
+    parent = importlib.import_module(f"coursekit.{package}")
+    found = [(int(m.group(1)), info.name) for info in pkgutil.iter_modules(parent.__path__)
+             if (m := re.fullmatch(r"ch(\d+)", info.name))]
+    return [importlib.import_module(f"{parent.__name__}.{name}") for _, name in sorted(found)]
+
+
+def _public_functions(package: str, test: Callable[[str], bool]) -> dict[str, Callable]:
+    """``{"chN.name": function}`` for the public functions of each chapter module that pass `test`."""
+    out = {}
+    for module in chapter_modules(package):
+        chapter = module.__name__.rsplit(".", 1)[1]
+        out.update({f"{chapter}.{name}": getattr(module, name) for name in module.__all__
+                    if test(name) and inspect.isfunction(getattr(module, name))})
+    return out
+
+
+def explorer_factories() -> dict[str, Callable]:
+    """Every explorer of the course: ``{"ch1.euler_explorer": euler_explorer, ...}``."""
+    return _public_functions("explorers", lambda name: name.endswith("_explorer"))
+
+
+def check_functions() -> dict[str, Callable]:
+    """Every exercise check of the course: ``{"ch1.check_msd_state_space": ..., ...}``."""
+    return _public_functions("exercises", lambda name: name.startswith("check_"))
+
+
+def chapter_notebooks(notebooks_dir) -> list[Path]:
+    """The chapter notebooks (``01_*.ipynb``, ``02_*.ipynb``, ...) of `notebooks_dir`, in order."""
+    folder = Path(notebooks_dir)
+    if not folder.is_dir():
+        raise ValueError(f"notebooks_dir {str(folder)!r} is not a directory; pass the folder "
+                         "that holds the chapter notebooks (notebooks/ in the repository)")
+    found = sorted(p for p in folder.glob("[0-9]*.ipynb") if p.is_file())
+    if not found:
+        raise ValueError(f"notebooks_dir {str(folder)!r} holds no chapter notebook "
+                         "(files named like 01_representations.ipynb)")
+    return found
