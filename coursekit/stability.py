@@ -17,7 +17,7 @@ import numpy as np
 from ._validation import as_scalar, as_square
 from .systems import StateSpace
 
-__all__ = ["is_stable", "stability_margin", "plot_poles"]
+__all__ = ["is_stable", "plot_poles", "format_poles"]
 
 
 def _matrix_and_dt(A, dt):
@@ -25,18 +25,6 @@ def _matrix_and_dt(A, dt):
     if isinstance(A, StateSpace):
         return A.A, A.dt if dt is None else as_scalar(dt, "dt", positive=True)
     return as_square(A, "A"), None if dt is None else as_scalar(dt, "dt", positive=True)
-
-
-def stability_margin(A, dt=None) -> float:
-    """How far the slowest pole is inside the stable region (negative = unstable).
-
-    Continuous time: ``-max Re(lambda)``; discrete time: ``1 - max |lambda|``.
-    """
-    A, dt = _matrix_and_dt(A, dt)
-    lam = np.linalg.eigvals(A)
-    if dt is None:
-        return float(-lam.real.max())
-    return float(1.0 - np.abs(lam).max())
 
 
 def is_stable(A, dt=None) -> bool:
@@ -144,3 +132,24 @@ def plot_poles(poles, *, dt=None, ax=None, title: str | None = None):
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
     ax.grid(True, alpha=0.3)
     return fig, ax
+
+
+def format_poles(poles, digits: int = 3) -> str:
+    """Poles (any complex numbers) as short text, e.g. for an explorer's readout:
+    ``"-1, -0.5 ± 2j"``, sorted by real part; a conjugate pair is written once."""
+    try:
+        values = np.atleast_1d(np.asarray(poles, dtype=complex)).ravel()
+    except (TypeError, ValueError):
+        raise ValueError(f"poles must be a list of numbers: received {poles!r}.") from None
+    if isinstance(poles, str) or not values.size or not np.all(np.isfinite(values)):
+        raise ValueError(f"poles must be a non-empty list of finite numbers: received {poles!r}.")
+    pending, out = sorted(values, key=lambda p: (p.real, -p.imag)), []
+    while pending:
+        p = pending.pop(0)
+        re, im = f"{p.real:.{digits}g}", f"{abs(p.imag):.{digits}g}j"
+        pair = next((q for q in pending if p.imag > 0 and np.isclose(q, np.conj(p))), None)
+        if pair is not None:
+            pending.remove(pair)
+        out.append(re if p.imag == 0 else f"{re} ± {im}" if pair is not None
+                   else f"{re} {'+' if p.imag > 0 else '-'} {im}")
+    return ", ".join(out)

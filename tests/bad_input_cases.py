@@ -480,9 +480,13 @@ ok("place", "complex pair", lambda: ck.place(A2, B2, [-1 + 1j, -1 - 1j]))
 ok("PlacementDetails", "fields", lambda: ck.place_details(A2, B2, P2).K)
 # the degree of the polynomial is the number of roots: no count is wrong, only none at all
 poles_cases("poly_from_roots", "poles", ck.poly_from_roots, P2, any_count=True)
-for _name, _fn in (("is_stable", ck.is_stable), ("stability_margin", ck.stability_margin)):
+for _name, _fn in (("is_stable", ck.is_stable),):
     matrix_cases(_name, "A", _fn, A2)
     scalar_cases(_name, "dt", lambda dt, _fn=_fn: _fn(A2, dt=dt), 0.1, positive=True, optional=True)
+ok("format_poles", "good", lambda: ck.format_poles([-1, -0.5 + 2j, -0.5 - 2j]))
+bad("format_poles", "poles text", lambda: ck.format_poles("-1, -2"), "poles")
+bad("format_poles", "poles None", lambda: ck.format_poles(None), "poles")
+bad("format_poles", "poles empty", lambda: ck.format_poles([]), "poles")
 ok("plot_poles", "good", lambda: ck.plot_poles({"open": [-1, -2], "closed": [-1 + 1j, -1 - 1j]}))
 bad("plot_poles", "poles None", lambda: ck.plot_poles(None), "poles")
 bad("plot_poles", "poles text", lambda: ck.plot_poles("-1, -2"), "poles")

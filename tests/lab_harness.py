@@ -34,7 +34,7 @@ __all__ = ["CHROMIUM_ARGS", "TOKEN", "VIEWPORT", "HarnessError", "chromium_path"
            "write_notebook", "running_lab", "launched_chromium", "new_lab_page", "open_notebook",
            "run_all", "wait_until_done", "close_all", "shut_down_kernels", "install_probe",
            "probe_state", "execute_in_kernel", "EXPLORER", "first_slider", "drag", "wait_until_quiet",
-           "error_outputs", "stderr_lines"]
+           "error_outputs", "stderr_lines", "axe_source", "axe_violations"]
 
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync", "--no-first-run"]
@@ -421,3 +421,27 @@ def wait_until_quiet(page, quiet_ms: float = 1000.0, timeout: float = 60.0) -> d
             return state
         page.wait_for_timeout(100)
     raise HarnessError(f"the figure kept changing for {timeout:.0f} s")
+
+
+def axe_source() -> str | None:
+    """The text of axe-core's ``axe.min.js`` (the npm package ``axe-core``), or None when it is not
+    installed: looked for at ``$AXE_CORE_JS``, then in ``node_modules`` of the repository
+    (``npm install axe-core`` there; ``.ci/run`` does it)."""
+    candidates = [os.environ.get("AXE_CORE_JS", ""),
+                  str(Path(__file__).resolve().parents[1] / "node_modules" / "axe-core" / "axe.min.js")]
+    for candidate in candidates:
+        if candidate and Path(candidate).is_file():
+            return Path(candidate).read_text(encoding="utf-8")
+    return None
+
+
+def axe_violations(page, selector: str, source: str) -> list[str]:
+    """axe-core's WCAG 2.1 A/AA violations inside the elements `selector` matches, one line each."""
+    page.add_script_tag(content=source)
+    found = page.evaluate("""async selector => {
+        const result = await axe.run(Array.from(document.querySelectorAll(selector)),
+            {runOnly: {type: 'tag', values: ['wcag2a', 'wcag2aa', 'wcag21a', 'wcag21aa']}});
+        return result.violations.map(v => `${v.id}: ${v.help} (${v.nodes.length} elements, e.g. `
+            + `${v.nodes[0].html.slice(0, 160)})`);
+    }""", selector)
+    return list(found)

@@ -169,19 +169,47 @@ def test_notebook_runs_in_jupyterlab_and_its_explorer_answers(name, page, opened
         assert not not_run, f"{name}: code cells {not_run} did not run (execution counts {counts})"
         images = page.evaluate(_EXPLORER_IMAGES_JS)
         assert images, f"{name}: no explorer figure (a widget with an image) was rendered"
+        _check_accessibility(page, name)
         idle_cpu = _kernel_cpu_while_idle(page)
         assert idle_cpu < 0.5, (f"{name}: the kernel used {idle_cpu:.2f} CPU-seconds in {IDLE_S} s while "
                                 "nobody touched a control (it should do no work)")
         t1 = time.monotonic()
+        alt_before = _first_explorer(page, "img", "alt")
         _move_first_slider(page)
         _wait_for_new_image(page, images[0], SLIDER_TIMEOUT_S)
         t_slider = time.monotonic() - t1
+        # the text alternative follows the slider, and the live region announces it once settled
+        alt = _first_explorer(page, "img", "alt")
+        value = _readout_value(page)
+        assert alt != alt_before and f"= {value:g}" in alt, (alt_before, alt, value)
+        page.wait_for_timeout(1500)
+        assert _first_explorer(page, ".ck-live", "textContent") == alt
         errors = lab_h.error_outputs(page)
         assert not errors, f"{name}: an error was reported after moving a slider:\n" + "\n----\n".join(errors)
         with capsys.disabled():
             print(f"\n[browser] {name}: open {t_open:.1f} s, run all {t_run:.1f} s "
                   f"({len(prompts)} code cells), kernel CPU while idle {idle_cpu:.2f} s in {IDLE_S} s, "
                   f"slider -> new figure {t_slider:.1f} s")
+
+
+def _first_explorer(page, selector: str, prop: str) -> str:
+    """A property of the first element `selector` matches in the first explorer."""
+    return page.locator(f"{lab_h.ACTIVE} .ck-explorer").first.locator(selector).first.evaluate(
+        f"e => e.{prop}")
+
+
+def _check_accessibility(page, name: str) -> None:
+    """axe-core finds no WCAG 2.1 AA violation inside the explorers; each figure has a text
+    alternative that names its settings, and each slider and dropdown an accessible name."""
+    source = lab_h.axe_source()
+    if source is None:
+        pytest.fail("axe-core is not installed: npm install axe-core in the repository (or set "
+                    "AXE_CORE_JS to its axe.min.js); .ci/run installs it")
+    violations = lab_h.axe_violations(page, f"{lab_h.ACTIVE} .ck-explorer", source)
+    assert not violations, f"{name}: accessibility violations in the explorers:\n" + "\n".join(violations)
+    alts = page.evaluate(f"() => Array.from(document.querySelectorAll('{lab_h.ACTIVE} .ck-explorer img'))"
+                         ".map(i => i.alt)")
+    assert alts and all("Settings:" in alt for alt in alts), alts
 
 
 def _kernel_cpu_while_idle(page) -> float:

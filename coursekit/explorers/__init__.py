@@ -4,6 +4,6 @@ Each explorer is a pure ``compute`` function (tested without a browser) plus
 a thin `Explorer` wrapper built by a ``*_explorer()`` function.
 """
 
-from ._base import Explorer, dropdown, format_poles, int_slider, rescale, slider
+from ._base import Explorer, dropdown, int_slider, rescale, slider
 
-__all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale", "format_poles"]
+__all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale"]

@@ -29,7 +29,7 @@ import numpy as np
 from .._validation import as_scalar
 from ._frames import FrameRenderer
 
-__all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale", "format_poles"]
+__all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale"]
 
 #: an explorer is never shrunk below this fraction of its natural size to fit the screen
 MIN_SCALE = 0.45
@@ -134,22 +134,6 @@ def _fit(ax, name: str, min_span: float, fill: float, keep: float) -> None:
         low = max([low, *(s for s in sticky if low < s <= lo)])
         high = min([high, *(s for s in sticky if hi <= s < high)])
         getattr(ax, f"set_{name}lim")(*scale.inverted().transform([low, high]))
-
-
-def format_poles(poles, digits: int = 3) -> str:
-    """Poles (or any complex numbers) as readable text for a readout: "-1, -0.5 ± 2j"; a
-    conjugate pair is written once."""
-    values = sorted(np.atleast_1d(np.asarray(poles, dtype=complex)), key=lambda p: (p.real, -p.imag))
-    out, pending = [], list(values)
-    while pending:
-        p = pending.pop(0)
-        re, im = f"{p.real:.{digits}g}", f"{abs(p.imag):.{digits}g}j"
-        pair = next((q for q in pending if p.imag > 0 and np.isclose(q, np.conj(p))), None)
-        if pair is not None:
-            pending.remove(pair)
-        out.append(re if p.imag == 0 else f"{re} ± {im}" if pair is not None
-                   else f"{re} {'+' if p.imag > 0 else '-'} {im}")
-    return ", ".join(out)
 
 
 def _fit_scale(natural_px, screen: dict, largest: float) -> float:

@@ -65,6 +65,7 @@ function render({ model, el }) {
   function report() {
     pending = null;
     if (!el.isConnected) return;
+    nameControls();
     const now = room(el), old = model.get("screen") || {};
     if (now.width > 0 && (Math.abs((old.width || 0) - now.width) > 2 ||
         Math.abs((old.height || 0) - now.height) > 2 || old.ratio !== now.ratio)) {
@@ -73,6 +74,20 @@ function render({ model, el }) {
     }
   }
   function schedule() { if (pending === null) pending = setTimeout(report, 150); }
+  // a slider's handle gets its label as its accessible name (ipywidgets leaves it unnamed);
+  // the explorer is found once the view is in the page
+  let explorer = null;
+  function nameControls() {
+    if (!explorer && (explorer = el.closest(".ck-explorer"))) {
+      named.observe(explorer, { childList: true, subtree: true });
+    }
+    for (const control of explorer?.querySelectorAll(".ck-controls > .widget-slider") || []) {
+      const handle = control.querySelector('[role="slider"]:not([aria-label])');
+      const label = control.querySelector(".widget-label")?.textContent.trim();
+      if (handle && label) handle.setAttribute("aria-label", label);
+    }
+  }
+  const named = new MutationObserver(nameControls);
 
   model.on("change:png", show);
   model.on("change:alt", describe);
@@ -86,6 +101,7 @@ function render({ model, el }) {
     model.off("change:png", show);
     model.off("change:alt", describe);
     resized.disconnect();
+    named.disconnect();
     window.removeEventListener("resize", schedule);
     clearTimeout(settle);
     clearTimeout(pending);

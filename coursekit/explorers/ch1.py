@@ -13,7 +13,8 @@ from .._validation import as_integer, as_scalar, time_grid
 from ..realization import euler_discretize
 from ..simulation import simulate
 from ..systems import StateSpace
-from ._base import Explorer, dropdown, format_poles, rescale, slider
+from ..stability import format_poles
+from ._base import Explorer, dropdown, rescale, slider
 
 __all__ = ["EULER_EXAMPLES", "euler_compute", "euler_explorer", "msd_compute", "msd_explorer"]
 

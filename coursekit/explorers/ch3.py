@@ -17,7 +17,8 @@ from ..linearization import linearize
 from ..placement import place
 from ..simulation import simulate, simulate_batch
 from ..systems import StateSpace
-from ._base import Explorer, format_poles, rescale, slider
+from ..stability import format_poles
+from ._base import Explorer, rescale, slider
 
 __all__ = [
     "pair_poles",

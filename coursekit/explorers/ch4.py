@@ -18,7 +18,8 @@ from ..kalman import kalman_gain, simulate_with_noise, white_noise
 from ..observability import place_observer
 from ..observers import observer_system
 from ..simulation import simulate
-from ._base import Explorer, format_poles, rescale, slider
+from ..stability import format_poles
+from ._base import Explorer, rescale, slider
 
 __all__ = ["KALMAN_TRUE_Q", "KALMAN_TRUE_R", "observer_noise_compute", "observer_noise_explorer", "kalman_tuning_compute",
            "kalman_tuning_explorer"]
