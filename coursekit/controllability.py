@@ -66,7 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import as_matrix, as_square
+from ._validation import as_matrix, as_square, as_system
 from .diagnostics import warn_accuracy
 from .systems import StateSpace
 
@@ -448,8 +448,7 @@ def ccf_transform(A, B) -> np.ndarray:
 
 def similarity_transform(sys: StateSpace, T) -> StateSpace:
     """Change of coordinates z = T x (2.50): returns (T A T^-1, T B, C T^-1, D)."""
-    if not isinstance(sys, StateSpace):
-        raise ValueError(f"sys must be a StateSpace: received {type(sys).__name__}.")
+    sys = as_system(sys, kind="linear", hint="build one with StateSpace(A, B, C, D).")
     T = as_square(T, "T", size=sys.n)
     if np.linalg.cond(T) > 1 / np.finfo(float).eps:
         raise ValueError("T is singular: a change of coordinates z = T x needs an invertible T.")

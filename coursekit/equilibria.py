@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_integer, as_matrix, as_scalar, as_vector
+from ._validation import as_integer, as_matrix, as_scalar, as_system, as_vector, foreign_library
 from .diagnostics import UserFunctionError, call_user
 from .linearization import _function_name, _sympy_column
 from .systems import NonlinearSystem, StateSpace, _raw_field
@@ -23,6 +23,8 @@ __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
 
 def _field(f, n=None, dt=None):
     """Return (func, name, n, m or None, dt) for a system or a bare function f(x, u)."""
+    if foreign_library(f):
+        f = as_system(f, "f")
     if isinstance(f, (NonlinearSystem, StateSpace)):
         return _raw_field(f), _function_name(getattr(f, "_f", f.f)), f.n, f.m, f.dt
     if not callable(f):

@@ -52,7 +52,7 @@ from typing import Callable
 import numpy as np
 
 from .diagnostics import UserFunctionError, call_user_fast, warn_accuracy
-from ._validation import as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
+from ._validation import as_scalar, as_series, as_square, as_system, as_time_grid, as_vector, is_uniform
 from .linearization import _jacobian, _perturbed, _quotients
 from .observability import _obs_pair
 from .simulation import SimulationResult, _agrees_column_by_column, lti_step_matrices
@@ -661,9 +661,8 @@ def kalman_bucy(sys, t, u, y, Q, R, P0, x0, *, substeps: int = 1) -> KalmanResul
     Returns a `KalmanResult` (estimate, P(t), L(t)). `substeps` RK4 steps
     (at least) are taken between samples.
     """
-    if not isinstance(sys, StateSpace) or sys.is_discrete:
-        raise ValueError(f"sys must be a continuous-time StateSpace: received {sys!r}; "
-                         "for a NonlinearSystem use extended_kalman_filter.")
+    sys = as_system(sys, kind="linear", time="continuous",
+                    hint="for a NonlinearSystem use extended_kalman_filter.")
     t, u, y = _records(t, u, y, sys.m)
     if y.shape[1] != sys.p:
         raise ValueError(f"y has the wrong number of columns: received {y.shape[1]}, "
@@ -791,9 +790,7 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
     (non-finite x̂ or P) raises RuntimeError with the time; the number of
     RK4 steps per sample interval is bounded, so no call can hang.
     """
-    if not isinstance(sys, NonlinearSystem) or sys.is_discrete:
-        raise ValueError(f"sys must be a continuous-time NonlinearSystem: received {sys!r}; "
-                         "for a StateSpace use kalman_bucy.")
+    sys = as_system(sys, kind="nonlinear", time="continuous", hint="for a StateSpace use kalman_bucy.")
     t, u, y = _records(t, u, y, sys.m)
     x0 = _initial_estimate(x0, sys.n)
     _user(_raw_field(sys), "f")(x0, u[0], t[0])
@@ -868,8 +865,7 @@ def simulate_with_noise(sys, t, u=None, x0=None, *, Q, R, seed=None) -> Simulati
     `u` is None or an array (N, m); `t` must be uniform. Deterministic for a
     given `seed` (int or ``numpy.random.Generator``): w is drawn first, then v.
     """
-    if not isinstance(sys, (StateSpace, NonlinearSystem)) or sys.is_discrete:
-        raise ValueError(f"sys must be a continuous-time StateSpace or NonlinearSystem: received {sys!r}.")
+    sys = as_system(sys, time="continuous")
     t = as_time_grid(t, "t")
     dt = _uniform_step(t)
     n, N = sys.n, t.size

@@ -20,7 +20,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import _is_complex, as_scalar, as_vector
+from ._validation import _is_complex, as_scalar, as_system, as_vector, foreign_library
 from .diagnostics import call_user, warn_accuracy
 from .systems import NonlinearSystem, StateSpace, _raw_field
 
@@ -35,6 +35,8 @@ def _function_name(func: Callable, role: str = "f") -> str:
 
 def _vector_field(f, x_eq, u_eq):
     """Return (func, name, x, u, n, m, dt): the user's f(x, u), how to name it, and the checked point."""
+    if foreign_library(f):
+        f = as_system(f, "f")
     if isinstance(f, (NonlinearSystem, StateSpace)):
         n, m, dt = f.n, f.m, f.dt
         x = as_vector(x_eq, "x_eq", size=n, why=f"one per state of the {n}-state system")

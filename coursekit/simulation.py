@@ -33,7 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
+from ._validation import (as_matrix, as_scalar, as_series, as_square, as_system, as_time_grid, as_vector,
+                          is_uniform)
 from .diagnostics import UserFunctionError, call_user
 from .systems import NonlinearSystem, StateSpace, _checked_call, _raw_field
 
@@ -137,11 +138,7 @@ def simulate(sys, t, u=None, x0=None, *, rtol: float = 1e-9, atol: float = 1e-12
         whatever is computed from it is meaningless; the error says up to
         which time the simulation is meaningful.
     """
-    if not isinstance(sys, (StateSpace, NonlinearSystem)):
-        raise ValueError(
-            f"sys must be a StateSpace or NonlinearSystem: received {type(sys).__name__}; "
-            "build one with StateSpace(A, B, C, D) or NonlinearSystem(f, n, m)."
-        )
+    sys = as_system(sys, hint="build one with StateSpace(A, B, C, D) or NonlinearSystem(f, n, m).")
     t = as_time_grid(t, "t", min_points=1 if sys.is_discrete else 2)
     x0 = np.zeros(sys.n) if x0 is None else as_vector(
         x0, "x0", size=sys.n, why=f"one per state of the {sys.n}-state system")
@@ -198,8 +195,8 @@ def simulate_batch(sys, t, x0s, u=None, *, rtol: float = 1e-9, atol: float = 1e-
     and at every evaluation; a failure names the function, the time and
     the trajectory.
     """
-    if not isinstance(sys, (StateSpace, NonlinearSystem)) or sys.is_discrete:
-        raise ValueError("sys must be a continuous-time StateSpace or NonlinearSystem for simulate_batch.")
+    sys = as_system(sys, time="continuous", hint="simulate_batch integrates an ODE; for a "
+                    "discrete-time system call simulate once per initial state.")
     t = as_time_grid(t, "t")
     X0 = as_matrix(x0s, "x0s", cols=sys.n, cols_why="one column per state")
     n, k, m = sys.n, X0.shape[0], sys.m

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_scalar, as_square
+from ._validation import as_scalar, as_square, as_system, foreign_library
 from .systems import StateSpace
 
 __all__ = ["is_stable", "stability_margin", "plot_poles"]
@@ -22,8 +22,9 @@ __all__ = ["is_stable", "stability_margin", "plot_poles"]
 
 def _matrix_and_dt(A, dt):
     """Accept a StateSpace (its own dt unless dt is given) or a square matrix."""
-    if isinstance(A, StateSpace):
-        return A.A, A.dt if dt is None else as_scalar(dt, "dt", positive=True)
+    if isinstance(A, StateSpace) or foreign_library(A):
+        sys = as_system(A, "A", kind="linear")
+        return sys.A, sys.dt if dt is None else as_scalar(dt, "dt", positive=True)
     return as_square(A, "A"), None if dt is None else as_scalar(dt, "dt", positive=True)
 
 
