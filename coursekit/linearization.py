@@ -1,7 +1,8 @@
 """Linear approximation of a nonlinear system around an equilibrium (section 3.4.2).
 
 * `linearize(f, x_eq, u_eq)` returns the Jacobians A = df/dx and B = df/du at
-  (x*, u*) (3.80), computed numerically: central differences over a ladder of
+  (x*, u*) (3.80), computed numerically: exact to rounding along the directions
+  in which f is affine; elsewhere central differences over a ladder of
   steps, refined by Richardson extrapolation, the most accurate one chosen by
   its error estimate (Ridders' method), so the accuracy does not depend on
   where the equilibrium lies (a pendulum that has turned 1000 times);
@@ -184,8 +185,70 @@ def _ridders_column(D: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, float
     return best, best_err
 
 
-def _column(g: Callable, z: np.ndarray, k: int, q: int) -> tuple[np.ndarray, float]:
-    """(dg/dz_k, error estimate) from the absolute ladders, or the relative one where it agrees.
+# A column along which g is affine (a straight line to rounding) is the same quotient at every
+# step, and the largest step rounds least: it is taken from three steps (powers of two of the
+# point's scale, its golden-ratio fraction, and 2^-10 of it) when their quotients agree and the
+# second differences vanish to _AFFINE_RTOL of the column's size, plus their rounding.
+_AFFINE_RTOL = 1e-12
+_AFFINE_STEPS = (1.0, _OTHER, 2.0 ** -10)
+# the rounding of a difference: a few eps of the values involved, with room for the rounding
+# of the arguments and of intermediate results inside g
+_ROUNDING = 64 * _EPS
+
+
+def _affine_column(g: Callable, z: np.ndarray, k: int, q: int,
+                   scale: float) -> tuple[np.ndarray, float] | None:
+    """(dg/dz_k, error estimate) when g is affine along e_k at the scale of the point, else None.
+
+    The steps are h = s * (1, 0.618..., 2^-10), s = 2^round(log2 max(scale, |z|)) / 4
+    (`scale`: the size of the whole point, x and u, whose rounding inside g a
+    step much smaller than it would magnify); for each, the central difference
+    D(h) must equal D(s) to _AFFINE_RTOL |D(s)| s / h, and g(z + h e_k) +
+    g(z - h e_k) - 2 g(z) must vanish to 8 _AFFINE_RTOL |D(s)| s, plus the
+    rounding of the values (rounding inside g is the same absolute error at
+    every step, hence the factors s / h and s). Then D(s) is exact to rounding
+    (no truncation error on a straight line), whatever the scale of the
+    coefficients; for a smooth f that passes, its error is below ~1e-11.
+    """
+    top = 2.0 ** np.round(np.log2(max(scale, float(np.abs(z).max())))) / 4
+    with np.errstate(all="ignore"):
+        center = _probe(g, z)
+        rows = [_sides(g, z, k, top * factor) for factor in _AFFINE_STEPS]
+    if center is None or center.size != q or any(row is None or row[0].size != q for row in rows):
+        return None
+    with np.errstate(all="ignore"):
+        quotients = [(plus - minus) / width for plus, minus, width in rows]
+        size = float(np.abs(quotients[0]).max())
+        worst = 0.0
+        for (plus, minus, width), D in zip(rows, quotients):
+            # rounding inside g (intermediate values larger than g's) is the same at every step, so
+            # its share of D grows like 1 / width: the tolerances grow alike, from the top step's
+            rounding = _ROUNDING * (np.abs(plus) + np.abs(minus) + 2 * np.abs(center) + abs(z[k]) * np.abs(D))
+            curvature = np.abs(plus + minus - 2 * center)
+            spread = np.abs(D - quotients[0])
+            if not (np.all(curvature <= _AFFINE_RTOL * size * 8 * top + rounding)
+                    and np.all(spread <= _AFFINE_RTOL * size * 2 * top / width + rounding / width)):
+                return None
+            worst = max(worst, float(spread.max()))
+    plus, minus, width = rows[0]
+    own = 2 * _EPS * float((np.abs(plus) + np.abs(minus) + abs(z[k]) * np.abs(quotients[0])).max()) / width
+    return quotients[0], max(own, worst)
+
+
+def _sides(g: Callable, z: np.ndarray, k: int, h: float):
+    """(g(z + h e_k), g(z - h e_k), the step actually taken), or None where g fails or is not finite."""
+    plus, minus = z.copy(), z.copy()
+    plus[k] += h
+    minus[k] -= h
+    values = [_probe(g, point) for point in (plus, minus)]
+    if any(v is None or not np.all(np.isfinite(v)) or v.size != values[0].size for v in values):
+        return None
+    return values[0], values[1], plus[k] - minus[k]
+
+
+def _column(g: Callable, z: np.ndarray, k: int, q: int, scale: float) -> tuple[np.ndarray, float]:
+    """(dg/dz_k, error estimate): exact where g is affine along e_k (`_affine_column`), else
+    from the absolute ladders, or the relative one where it agrees.
 
     The tableau's own estimate can be fooled by noise or a kink (a lucky
     agreement of two entries), so a second absolute ladder on other points
@@ -193,6 +256,9 @@ def _column(g: Callable, z: np.ndarray, k: int, q: int) -> tuple[np.ndarray, flo
     well, and the two results' disagreement is a lower bound of the error
     (`_agreed`).
     """
+    affine = _affine_column(g, z, k, q, scale)
+    if affine is not None:
+        return affine
     J, err = _agreed([_quotient_ladder(g, z, k, q, _ABSOLUTE_TOP * scale) for scale in (1.0, _OTHER)])
     if abs(z[k]) > _RELATIVE:
         h0 = 2.0 ** np.round(np.log2(abs(z[k]))) / 4
@@ -225,12 +291,14 @@ def _agreed(ladders: list) -> tuple[np.ndarray, float]:
     return best, best_err
 
 
-def _ridders(g: Callable, z: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
-    """(J, err): the Jacobian (q, n) of g at z by Ridders' method and each column's error estimate."""
+def _ridders(g: Callable, z: np.ndarray, q: int, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(J, err): the Jacobian (q, n) of g at z by Ridders' method and each column's error estimate.
+
+    Columns along which g is affine are exact (`_affine_column`, at least `scale` wide)."""
     J = np.full((q, z.size), np.nan)
     err = np.full(z.size, np.inf)
     for k in range(z.size):
-        J[:, k], err[k] = _column(g, z, k, q)
+        J[:, k], err[k] = _column(g, z, k, q, scale)
     return J, err
 
 
@@ -255,13 +323,13 @@ _JACOBIAN_RTOL = 1e-7
 
 
 def _checked_jacobian(g: Callable, z: np.ndarray, q: int, *, symbol: str, variable: str,
-                      name: str, checked: Callable) -> np.ndarray:
+                      name: str, checked: Callable, scale: float = 1.0) -> np.ndarray:
     """Ridders' Jacobian of g at z; raises on NaN, warns when a column is not accurate.
 
     `checked(z, where)` evaluates the same function through `call_user`: for a
     column without any usable step it re-raises what f did there, with context.
     """
-    J, err = _ridders(g, z, q)
+    J, err = _ridders(g, z, q, scale)
     for k in range(z.size):
         if not np.all(np.isfinite(J[:, k])):
             step = z.copy()
@@ -318,8 +386,12 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     A : (n, n) array  -- df/dx at (x*, u*)
     B : (n, m) array  -- df/du at (x*, u*) (m = 0 columns without input)
 
-    Accuracy: each column is the central difference (f(x + h e_k) - f(x -
-    h e_k)) / 2h over a ladder of 30 steps halving from h = 1/4 (and, for
+    Accuracy: a column along which f is affine (a straight line: linear
+    dynamics, a bilinear term, an input that enters linearly) is exact to
+    rounding at any scale of the coefficients: the central difference is then
+    the same at every step, which three steps at the scale of (x*, u*) check
+    (`_affine_column`), and the largest is taken. Every other column is the
+    central difference (f(x + h e_k) - f(x - h e_k)) / 2h over a ladder of 30 steps halving from h = 1/4 (and, for
     |x_k| > 16, a second ladder from |x_k| / 4, used where it agrees),
     extrapolated (Richardson, up to h^12) and chosen by its error estimate
     (Ridders' method), which is cross-checked against a second ladder on
@@ -348,11 +420,12 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
         raise ValueError(f"{name} returned {f0.size} numbers at x_eq; expected {n} (one per state).")
     if check_equilibrium:
         _check_equilibrium(f0, x, u, dt, tol, name)
-    # (3.80): A = df/dx (x*, u*),  B = df/du (x*, u*)
+    # (3.80): A = df/dx (x*, u*),  B = df/du (x*, u*); straight lines are tried at the point's scale
+    scale = max(1.0, float(np.abs(x).max(initial=0)), float(np.abs(u).max(initial=0)))
     A = _checked_jacobian(lambda z: func(z, u), x, n, symbol="A", variable="x", name=name,
-                          checked=lambda z, where: checked(z, u, where))
+                          checked=lambda z, where: checked(z, u, where), scale=scale)
     B = (_checked_jacobian(lambda w: func(x, w), u, n, symbol="B", variable="u", name=name,
-                           checked=lambda w, where: checked(x, w, where))
+                           checked=lambda w, where: checked(x, w, where), scale=scale)
          if m else np.zeros((n, 0)))
     return A, B
 
