@@ -15,7 +15,7 @@ import numpy as np
 
 from ._validation import as_integer, as_matrix, as_scalar, as_system, as_vector, foreign_library
 from .diagnostics import UserFunctionError, call_user
-from .linearization import _function_name, _sympy_column
+from .linearization import _function_name, _input_size_explained, _sympy_column
 from .systems import NonlinearSystem, StateSpace, _raw_field
 
 __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
@@ -101,7 +101,8 @@ def find_equilibria(f, u_eq=None, guesses=None, *, n=None, dt=None, bounds=(-5.0
     u = _input(u_eq, m)
     X0 = _guesses(guesses, n_sys, bounds, count, seed)
     task = "find_equilibria, searching from the guess {}"
-    _check_at_guesses(func, name, dt, u, X0, task, inferred=n_sys is None)
+    with _input_size_explained(u_eq, u, "find_equilibria"):
+        _check_at_guesses(func, name, dt, u, X0, task, inferred=n_sys is None)
     from scipy.optimize import root
     found = []
     for x0 in X0:

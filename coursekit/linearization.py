@@ -16,12 +16,13 @@ The linear model describes the deviations dx = x - x*, du = u - u* (3.61),
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from functools import cache
 from typing import Callable
 
 import numpy as np
 
-from ._validation import _is_complex, as_scalar, as_system, as_vector, foreign_library
+from ._validation import _is_complex, as_flag, as_scalar, as_system, as_vector, foreign_library
 from .diagnostics import call_user, warn_accuracy
 from .systems import NonlinearSystem, StateSpace, _raw_field
 
@@ -411,11 +412,14 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     func, name, x, u, n, m, sys_dt = _vector_field(f, x_eq, u_eq)
     dt = sys_dt if dt is None else as_scalar(dt, "dt", positive=True)
     tol = as_scalar(tol, "tol", positive=True)
+    check_equilibrium = as_flag(check_equilibrium, "check_equilibrium",
+                                hint="pass check_equilibrium=False to linearize around any point")
 
     def checked(xx, uu, where):
         return np.ravel(call_user(func, (xx, uu), name, where=where))
 
-    f0 = checked(x, u, f"at x_eq = {x.tolist()}, u_eq = {u.tolist()}")
+    with _input_size_explained(u_eq, u, "linearize"):
+        f0 = checked(x, u, f"at x_eq = {x.tolist()}, u_eq = {u.tolist()}")
     if f0.size != n:
         raise ValueError(f"{name} returned {f0.size} numbers at x_eq; expected {n} (one per state).")
     if check_equilibrium:
@@ -428,6 +432,27 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
                            checked=lambda w, where: checked(x, w, where), scale=scale)
          if m else np.zeros((n, 0)))
     return A, B
+
+
+@contextmanager
+def _input_size_explained(u_eq, u: np.ndarray, task: str):
+    """Turn an IndexError of the user's f at the first call into "u_eq is missing / too short".
+
+    f(x, u) that reads u[0] fails with the student's own IndexError when u_eq
+    was left out (u is then empty); the message says which argument to pass.
+    """
+    from .diagnostics import UserFunctionError
+    try:
+        yield
+    except UserFunctionError as err:
+        if not isinstance(err.__cause__, IndexError):
+            raise
+        state = "is missing" if u_eq is None else f"may be too short ({u.size} entries)"
+        raise ValueError(
+            f"u_eq {state}: {err}. Pass {task} the input u* with one entry per input that f reads "
+            "(f uses u[0], u[1], ...), e.g. u_eq=[0.0]; if f reads no input, check that each state "
+            "has its entry in x."
+        ) from err
 
 
 def _check_equilibrium(f0, x, u, dt, tol, name: str = "f") -> None:

@@ -328,3 +328,19 @@ def test_random_affine_maps_are_exact_at_every_scale(n, m, seed, coefficients, x
     for J, J0 in ((A, A0), (B, B0)):
         tol = 16 * eps * np.abs(J0).max(axis=0, initial=0.0) + 64 * eps * offset / size
         assert np.all(np.abs(J - J0) <= tol[None, :]), (np.abs(J - J0).max(axis=0), tol)
+
+
+def test_a_missing_u_eq_is_named_instead_of_the_students_index_error():
+    def pend(x, u):
+        return np.array([x[1], -9.81 * np.sin(x[0]) + u[0]])
+
+    with pytest.raises(ValueError, match=r"^u_eq is missing: f \(pend\) raised IndexError(?s:.*)u_eq=\[0\.0\]"):
+        ck.linearize(pend, [0.0, 0.0])
+    with pytest.raises(ValueError, match=r"^u_eq is missing: .*find_equilibria"):
+        ck.find_equilibria(pend, n=2)
+
+
+@pytest.mark.parametrize("flag", ["no", None, 0, 1, "False"])
+def test_check_equilibrium_must_be_a_real_bool(flag):
+    with pytest.raises(ValueError, match=r"check_equilibrium must be True or False"):
+        ck.linearize(lambda x, u: -x, [1.0], check_equilibrium=flag)
