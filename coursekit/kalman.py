@@ -632,8 +632,22 @@ def _estimate_pass(sys, G, w, x0, steps):
     return np.vstack([x0, after[last]])
 
 
+# RK4's error falls like h^4: 1000 steps per sample interval are 1e-12 of one step's error, and
+# more only cost time in proportion (10^9 of them made the filters run for hours)
+_MAX_SUBSTEPS = 1000
+
+
 def _substeps(substeps) -> int:
-    return int(as_scalar(substeps, "substeps", positive=True, integer=True))
+    """`substeps` checked: a whole number from 1 to _MAX_SUBSTEPS."""
+    k = int(as_scalar(substeps, "substeps", positive=True, integer=True))
+    if k > _MAX_SUBSTEPS:
+        raise ValueError(
+            f"substeps must be at most {_MAX_SUBSTEPS}: received {k}. RK4's error falls like the "
+            f"fourth power of the step, so {_MAX_SUBSTEPS} steps per sample are already exact to "
+            "rounding for any smooth model, and more only cost time; the step also shrinks by "
+            "itself where P changes fast. For a finer estimate, sample y on a finer grid t."
+        )
+    return k
 
 
 def _initial_estimate(x0, n: int) -> np.ndarray:
@@ -659,7 +673,7 @@ def kalman_bucy(sys, t, u, y, Q, R, P0, x0, *, substeps: int = 1) -> KalmanResul
     docstring). As t grows P(t) tends to the solution of `kalman_gain`.
 
     Returns a `KalmanResult` (estimate, P(t), L(t)). `substeps` RK4 steps
-    (at least) are taken between samples.
+    (at least; 1 to 1000, ValueError beyond) are taken between samples.
     """
     sys = as_system(sys, kind="linear", time="continuous",
                     hint="for a NonlinearSystem use extended_kalman_filter.")
