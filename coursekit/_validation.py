@@ -63,7 +63,7 @@ def _is_complex(value) -> bool:
         # sympy numbers and matrices: complex when some entry has an imaginary part
         try:
             return bool(np.any(np.asarray(value, dtype=complex).imag != 0))
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             return False
     return False
 
@@ -267,10 +267,28 @@ def as_text(value, name: str, *, expected: str = "a string") -> str:
     return value
 
 
-def time_grid(t_end, samples, *, t_end_name: str = "t_end") -> np.ndarray:
-    """``np.linspace(0, t_end, samples)`` after checking t_end > 0 and samples >= 2 (named)."""
+#: the most samples `time_grid` allocates (8 MB), and the longest span it covers by default
+MAX_SAMPLES = 10**6
+MAX_SPAN = 1e6
+
+
+def time_grid(t_end, samples, *, t_end_name: str = "t_end", max_span: float | None = MAX_SPAN) -> np.ndarray:
+    """``np.linspace(0, t_end, samples)`` after checking 0 < t_end <= max_span and 2 <= samples <= 10^6.
+
+    Each bound is checked before anything is allocated or integrated, and named
+    (a huge `samples` ran out of memory, a t_end of 1e300 made the solvers work
+    for ever); ``max_span=None`` for a span chosen elsewhere (a plan's horizon).
+    """
     t_end = as_scalar(t_end, t_end_name, positive=True)
     samples = as_integer(samples, "samples", minimum=2, why="a time grid needs a start and an end")
+    if samples > MAX_SAMPLES:
+        raise ValueError(f"samples must be at most {MAX_SAMPLES:,}: received {samples:,}, which would "
+                         f"need {8 * samples / 1e9:.3g} GB per curve; a figure shows no more than a few "
+                         "thousand points, so pass e.g. samples=1000.")
+    if max_span is not None and t_end > max_span:
+        raise ValueError(f"{t_end_name} is too large: a time span of {t_end:g} exceeds {max_span:g}, the "
+                         "longest these computations are meant for (seconds to minutes of motion); "
+                         f"pass a smaller {t_end_name}, or call simulate yourself for a long horizon.")
     return np.linspace(0.0, t_end, samples)
 
 

@@ -47,7 +47,7 @@ def _input_time(t, horizon: float) -> float:
 
 def _plan_grid(horizon: float, samples) -> np.ndarray:
     """The plot grid of a plan: `samples` (>= 2) times on [0, T]."""
-    return time_grid(horizon, samples, t_end_name="T")
+    return time_grid(horizon, samples, t_end_name="T", max_span=None)
 
 
 def _derivative_order(k) -> int:
