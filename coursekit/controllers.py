@@ -56,6 +56,9 @@ def _states(x, n: int, name: str = "x", gain: str = "") -> np.ndarray:
         since = f", since {gain}" if gain else ""
         raise ValueError(f"{name} has shape {x.shape}: expected ({n},), one entry per state{since}, "
                          f"or ({n}, k) for a batch of k states as columns.")
+    if not np.isfinite(x).all():
+        raise ValueError(f"{name} contains NaN or infinite entries: received {_fmt(x)}; a control law "
+                         "needs a measured state (look for where the state became NaN or inf).")
     return x
 
 

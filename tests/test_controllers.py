@@ -227,3 +227,12 @@ def test_with_integrators_takes_a_batch_like_its_plant():
     batch = sys.f(X, U)
     single = np.column_stack([sys.f(X[:, j], U[:, j]) for j in range(4)])
     np.testing.assert_allclose(batch, single, rtol=1e-13, atol=1e-13)   # rounding only
+
+
+@pytest.mark.parametrize("controller", [lambda: ck.StateFeedback([[-1.0, -2.0]]),
+                                        lambda: ck.PendulumLinearizingController([-1.0, -2.0])])
+@pytest.mark.parametrize("x", [[np.nan, 0.0], [0.0, np.inf], [[0.0, np.nan], [1.0, 1.0]]])
+def test_a_state_with_nan_or_inf_is_refused_naming_x(controller, x):
+    # issue 25: u came back NaN without a word
+    with pytest.raises(ValueError, match=r"^x contains NaN or infinite entries"):
+        controller()(0.0, np.array(x))
