@@ -25,6 +25,7 @@ __all__ = [
     "is_uniform",
     "as_poles",
     "as_integer",
+    "as_dt",
     "as_text",
     "as_flag",
     "time_grid",
@@ -239,6 +240,21 @@ def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False
     if integer and x != round(x):
         raise ValueError(f"{name} must be a whole number: received {x!r}.")
     return x
+
+
+def as_dt(value, name: str = "dt") -> float | None:
+    """A time base: None (continuous time) or a sampling period > 0.
+
+    0 is refused with a pointer to None: python-control writes continuous time as
+    dt=0, coursekit as dt=None.
+    """
+    if value is None:
+        return None
+    if as_scalar(value, name) == 0:
+        raise ValueError(f"{name} must be positive: received 0.0, but a sampling period is > 0; for a "
+                         f"continuous-time system pass {name}=None or leave {name} out (python-control "
+                         "writes continuous time as dt=0, coursekit as dt=None).")
+    return as_scalar(value, name, positive=True)
 
 
 def as_integer(value, name: str, *, minimum: int | None = None, why: str = "") -> int:

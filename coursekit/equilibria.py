@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_integer, as_matrix, as_scalar, as_system, as_vector, foreign_library
+from ._validation import as_dt, as_integer, as_matrix, as_scalar, as_system, as_vector, foreign_library
 from .diagnostics import UserFunctionError, call_user
 from .linearization import _function_name, _input_size_explained, _sympy_column
 from .systems import NonlinearSystem, StateSpace, _raw_field
@@ -96,7 +96,7 @@ def find_equilibria(f, u_eq=None, guesses=None, *, n=None, dt=None, bounds=(-5.0
     if n is not None:
         n = as_integer(n, "n", minimum=1, why="the number of states of the system")
     func, name, n_sys, m, sys_dt = _field(f, n, dt)
-    dt = sys_dt if dt is None else as_scalar(dt, "dt", positive=True)
+    dt = sys_dt if dt is None else as_dt(dt)
     tol = as_scalar(tol, "tol", positive=True)
     u = _input(u_eq, m)
     X0 = _guesses(guesses, n_sys, bounds, count, seed)

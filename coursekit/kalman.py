@@ -52,7 +52,7 @@ from typing import Callable
 import numpy as np
 
 from .diagnostics import UserFunctionError, call_user_fast, warn_accuracy
-from ._validation import as_scalar, as_series, as_square, as_system, as_time_grid, as_vector, is_uniform
+from ._validation import as_dt, as_scalar, as_series, as_square, as_system, as_time_grid, as_vector, is_uniform
 from .linearization import _jacobian, _perturbed, _quotients
 from .observability import _obs_pair
 from .simulation import SimulationResult, _agrees_column_by_column, lti_step_matrices
@@ -169,8 +169,7 @@ def kalman_gain(A, C, Q, R, *, dt=None) -> tuple[np.ndarray, np.ndarray]:
     off by more than rounding explains.
     """
     A, C, Q, R = _gain_inputs(A, C, Q, R)
-    if dt is not None:
-        dt = as_scalar(dt, "dt", positive=True)
+    dt = as_dt(dt)
     P = _solve_riccati(A, C, Q, R, dt)
     if dt is None:
         # (4.87): L = P C^T R^{-1}

@@ -22,7 +22,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import _is_complex, as_flag, as_scalar, as_system, as_vector, foreign_library
+from ._validation import _is_complex, as_dt, as_flag, as_scalar, as_system, as_vector, foreign_library
 from .diagnostics import call_user, warn_accuracy
 from .systems import NonlinearSystem, StateSpace, _raw_field
 
@@ -410,7 +410,7 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     `UserFunctionError` (a ValueError) naming the function and the point.
     """
     func, name, x, u, n, m, sys_dt = _vector_field(f, x_eq, u_eq)
-    dt = sys_dt if dt is None else as_scalar(dt, "dt", positive=True)
+    dt = sys_dt if dt is None else as_dt(dt)
     tol = as_scalar(tol, "tol", positive=True)
     check_equilibrium = as_flag(check_equilibrium, "check_equilibrium",
                                 hint="pass check_equilibrium=False to linearize around any point")

@@ -76,3 +76,18 @@ def new_figure(nrows: int = 1, ncols: int = 1, *, figsize=None, **subplot_kw):
     fig = fit_margins(Figure(figsize=figsize))
     axes = fig.subplots(nrows, ncols, squeeze=True, **subplot_kw)
     return fig, axes
+
+
+def figure_for(ax, *, figsize=None):
+    """(fig, ax): a new figure when `ax` is None, else the figure of the Axes `ax` (checked).
+
+    Anything but a matplotlib Axes raises ValueError naming `ax`, instead of an
+    AttributeError deep inside the drawing.
+    """
+    if ax is None:
+        return new_figure(1, 1, figsize=figsize)
+    from matplotlib.axes import Axes
+    if not isinstance(ax, Axes):
+        raise ValueError(f"ax must be a matplotlib Axes: received {type(ax).__name__}; "
+                         "leave it out to draw a new figure, or pass one axes of new_figure().")
+    return ax.figure, ax

@@ -48,3 +48,16 @@ def test_the_explorers_compute_functions_refuse_huge_spans_and_samples_at_once(c
     with pytest.raises(ValueError, match=r"^(t_end|T) is too large|^samples must be at most"):
         call()
     assert time.perf_counter() - start < 1.0
+
+
+@pytest.mark.parametrize("call", [
+    lambda: __import__("coursekit").StateSpace([[-1.0]], [[1.0]], dt=0),
+    lambda: __import__("coursekit").NonlinearSystem(lambda x, u: -x, n=1, dt=0.0),
+    lambda: __import__("coursekit").is_stable([[-1.0]], dt=0),
+    lambda: __import__("coursekit").kalman_gain([[-1.0]], [[1.0]], [[1.0]], [[1.0]], dt=0),
+    lambda: __import__("coursekit").linearize(lambda x, u: -x, [0.0], dt=0),
+])
+def test_dt_zero_points_to_dt_none(call):
+    # issue 25: dt=0 (python-control's continuous time) was refused without the way out
+    with pytest.raises(ValueError, match=r"^dt must be positive: received 0\.0(?s:.*)pass dt=None"):
+        call()
