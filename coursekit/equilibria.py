@@ -249,7 +249,7 @@ def symbolic_equilibria(f, unknowns, *, discrete: bool = False):
     """
     import sympy as sp
     F = list(_sympy_column(f, "f"))
-    X = list(_sympy_column(unknowns, "unknowns")) if unknowns is not None else []
+    X = list(_sympy_column(unknowns, "unknowns", allow_empty=True)) if unknowns is not None else []
     if not X or not all(isinstance(v, sp.Symbol) for v in X):
         raise ValueError(f"unknowns must be a non-empty list of sympy symbols: received {unknowns!r}.")
     if discrete:

@@ -493,7 +493,7 @@ def linearize_symbolic(f, x, u=None, x_eq=None, u_eq=None):
     """
     import sympy as sp
     X = _sympy_column(x, "x")
-    U = _sympy_column(u, "u") if u is not None else sp.zeros(0, 1)
+    U = _sympy_column(u, "u", allow_empty=True) if u is not None else sp.zeros(0, 1)
     if x_eq is None:
         raise ValueError("x_eq is missing: pass the equilibrium as a list, e.g. [sp.pi, 0].")
     subs = dict(zip(X, _values(x_eq, len(X), "x_eq")))
@@ -506,15 +506,22 @@ def linearize_symbolic(f, x, u=None, x_eq=None, u_eq=None):
     return A, B
 
 
-def _sympy_column(values, name: str):
+def _sympy_column(values, name: str, *, allow_empty: bool = False):
+    """`values` (a list or sympy Matrix of expressions) as a sympy column; text and (unless
+    `allow_empty`) an empty list raise ValueError naming `name`."""
     import sympy as sp
-    if isinstance(values, str):
-        raise ValueError(f"{name} must be a list of sympy expressions: received the text {values!r}; "
+    texts = [values] if isinstance(values, str) else \
+        [v for v in values if isinstance(v, str)] if isinstance(values, (list, tuple)) else []
+    if texts:
+        raise ValueError(f"{name} must be a list of sympy expressions: received the text {texts[0]!r}; "
                          "build expressions from symbols, e.g. x1, x2 = sp.symbols('x1 x2').")
     try:
         M = sp.Matrix(values)
-    except (TypeError, ValueError, sp.SympifyError):
+    except (TypeError, ValueError, NotImplementedError, sp.SympifyError):
         raise ValueError(f"{name} must be a list of sympy expressions: received {values!r}.") from None
+    if len(M) == 0 and not allow_empty:
+        raise ValueError(f"{name} is empty: expected at least one expression, e.g. [x1, x2] "
+                         "from x1, x2 = sp.symbols('x1 x2').")
     if M.shape[1] != 1:
         M = M.reshape(len(M), 1)
     return M

@@ -344,3 +344,20 @@ def test_a_missing_u_eq_is_named_instead_of_the_students_index_error():
 def test_check_equilibrium_must_be_a_real_bool(flag):
     with pytest.raises(ValueError, match=r"check_equilibrium must be True or False"):
         ck.linearize(lambda x, u: -x, [1.0], check_equilibrium=flag)
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda x1, x2: ck.symbolic_jacobian([x2, -sp.sin(x1)], []), "variables is empty"),
+    (lambda x1, x2: ck.symbolic_jacobian([x2, -sp.sin(x1)], ["x1", "x2"]), "variables must be a list"),
+    (lambda x1, x2: ck.symbolic_jacobian([], [x1, x2]), "f is empty"),
+    (lambda x1, x2: ck.linearize_symbolic([x2, -sp.sin(x1)], [], x_eq=[]), "x is empty"),
+    (lambda x1, x2: ck.linearize_symbolic([x2, -sp.sin(x1)], "x1 x2", x_eq=[0, 0]), "x must be a list"),
+])
+def test_empty_or_text_symbol_lists_are_refused(call, name):
+    # issue 25: an empty list gave an empty Jacobian without a word
+    with pytest.raises(ValueError, match=rf"^{name}"):
+        call(*sp.symbols("x1 x2"))
+    # no input at all stays allowed
+    x1, x2 = sp.symbols("x1 x2")
+    A, B = ck.linearize_symbolic([x2, -sp.sin(x1)], [x1, x2], [], x_eq=[0, 0])
+    assert B.shape == (2, 0)
