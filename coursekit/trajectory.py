@@ -23,7 +23,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_integer, as_scalar, as_series, as_vector, time_grid
+from ._validation import as_integer, as_scalar, as_series, as_time_grid, as_vector, time_grid
 from .controllability import _pair, ccf_transform, charpoly
 from .diagnostics import call_user, warn_accuracy
 
@@ -443,7 +443,7 @@ def plot_plan(t, x, u, *, title: str):
     (time-major; a 1-D `u` is one input). Raises ValueError naming the
     argument whose shape does not fit.
     """
-    t = as_vector(t, "t")
+    t = as_time_grid(t, "t")
     x = as_series(x, "x", samples=t.size)
     u = as_series(u, "u", samples=t.size)
     title = str(title)
