@@ -282,10 +282,11 @@ def _modes_of(A, Q):
     return lam, V, driven
 
 
-def _fmt_mode(lam: complex) -> str:
-    if abs(lam.imag) <= 1e-12 * abs(lam):
-        return f"{lam.real:.4g}"
-    return f"{lam.real:.4g} ± {abs(lam.imag):.4g}j"
+def _fmt_mode(lam: complex, tol: float = 0.0) -> str:
+    """λ for a message; parts within `tol` (rounding at A's scale) are printed as the 0 they are."""
+    re = 0.0 if abs(lam.real) <= tol else lam.real
+    im = 0.0 if abs(lam.imag) <= max(tol, 1e-12 * abs(lam)) else abs(lam.imag)
+    return f"{re:.4g}" if im == 0.0 else f"{re:.4g} ± {im:.4g}j"
 
 
 def _mode_reason(A, C, lam, v, dt, tol, closed_loop: bool, driven: bool) -> str | None:
@@ -294,22 +295,23 @@ def _mode_reason(A, C, lam, v, dt, tol, closed_loop: bool, driven: bool) -> str 
     margin = -lam.real if dt is None else 1.0 - abs(lam)
     kind = where if abs(margin) <= tol else "unstable"
     v = v / v[np.argmax(np.abs(v))]
-    shown = np.array2string(v.real if np.isrealobj(v) or not np.abs(v.imag).any() else v,
-                            precision=3, suppress_small=True)
+    shown = np.array2string((v.real if np.isrealobj(v) or not np.abs(v.imag).any() else v) + 0.0,
+                            precision=3, suppress_small=True)   # + 0.0: no "-0."
+    lam_text = _fmt_mode(lam, tol)
     if np.linalg.norm(C @ v) <= 1e-8 * np.linalg.norm(C, 2) * np.linalg.norm(v):
-        return (f"the mode λ = {_fmt_mode(lam)} of A (eigenvector {shown}) is {kind} and not "
+        return (f"the mode λ = {lam_text} of A (eigenvector {shown}) is {kind} and not "
                 "observable through C (C v = 0): y carries no trace of it, so no gain L can "
                 "move it ((A, C) is not detectable). Measure it (add a row to C that sees "
                 "this mode) or remove it from the model.")
     if kind == where and not driven:
-        return (f"the mode λ = {_fmt_mode(lam)} of A (eigenvector {shown}) lies {where} and the "
+        return (f"the mode λ = {lam_text} of A (eigenvector {shown}) lies {where} and the "
                 "process noise Q does not drive it: the model then claims this undamped mode "
                 "is known exactly, the steady-state gain leaves it uncorrected and the "
                 "estimation error never decays. Let Q act on it (e.g. Q = q * np.eye(n) with "
                 "a small q > 0), or use the time-varying filter, whose gain decays.")
     if closed_loop:
         return (f"the solver returned a solution that is not stabilizing (A - L C has the "
-                f"unstable eigenvalue {_fmt_mode(lam)}): the equation is too badly conditioned; "
+                f"unstable eigenvalue {lam_text}): the equation is too badly conditioned; "
                 "check the units of Q and R, or rescale the states.")
     return None
 
@@ -325,10 +327,13 @@ def _no_stabilizing_solution(A, C, dt, lam, V, driven=None, *, solver: str = "",
     """
     driven = np.zeros(lam.size, bool) if driven is None else driven
     _, _, tol = _unstable_modes(A, dt)
-    reasons = []
+    reasons, seen = [], []
     for k in range(lam.size):
-        if lam[k].imag < 0:                                  # one of each conjugate pair
+        # one of each conjugate pair, and one of a repeated eigenvalue (a Jordan block, whose
+        # eigenvectors coincide: the same paragraph twice)
+        if lam[k].imag < 0 or any(abs(lam[k] - other) <= max(tol, 1e-8 * abs(other)) for other in seen):
             continue
+        seen.append(lam[k])
         margin = -lam[k].real if dt is None else 1.0 - abs(lam[k])
         if not closed_loop and margin > tol:                 # a stable mode of A is harmless
             continue

@@ -502,3 +502,18 @@ def test_absurd_substeps_are_refused_before_any_work():
     # the limit itself is allowed, and agrees with the default to RK4's accuracy
     np.testing.assert_allclose(ck.kalman_bucy(sys, *args, substeps=1000).x,
                                ck.kalman_bucy(sys, *args).x, atol=1e-9)
+
+
+def test_the_no_solution_message_names_each_mode_once_and_rounding_as_zero():
+    # issue 25: with Q = 0 the double integrator's Jordan block gave the same paragraph twice,
+    # and a rotated mode at 0 was printed as lambda = -1.11e-16
+    with pytest.raises(ValueError) as info:
+        ck.kalman_gain([[0.0, 1.0], [0.0, 0.0]], [[1.0, 0.0]], np.zeros((2, 2)), [[1.0]])
+    text = str(info.value)
+    assert text.count("the mode λ = 0 of A (eigenvector [1. 0.])") == 1, text
+    assert "-0." not in text
+    rng = np.random.default_rng(3)
+    rotation, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    A = rotation @ np.diag([0.0, -1.0, -2.0]) @ rotation.T     # eig: about -1.1e-16, -1, -2
+    with pytest.raises(ValueError, match=r"the mode λ = 0 of A \(eigenvector"):
+        ck.kalman_gain(A, np.array([[1.0, 0.0, 0.0]]) @ rotation.T, np.zeros((3, 3)), [[1.0]])
