@@ -44,6 +44,7 @@ P200 = -np.linspace(1, 20, 200)
 x1, x2 = sp.symbols("x1 x2")
 SYMF = [x2, -sp.sin(x1)]
 T_ILL = np.array([[1.0, 1.0], [1.0, 1.0 + 1e-15]])
+ROT = np.linalg.qr(np.random.default_rng(3).normal(size=(3, 3)))[0]
 '''
 
 # (kind, argument the message must name, call); kind: bad (an error), warn (an error or a
@@ -112,7 +113,8 @@ CALLS = [
     ("bad", "dt", "ck.StateSpace(A2, B2, C2, dt=0)", "dt=None"),
     ("bad", "u_eq", "ck.linearize(pend_f, [0.0, 0.0])"),
     ("bad", "m", "ck.equilibrium_input(pend_f, [0.0, 0.0], m=0)"),
-    ("bad", "Q", "ck.kalman_gain(np.diag([1.0, -1.0]), [[1.0, 0.0]], np.zeros((2, 2)), [[1.0]])", "no_repeat"),
+    ("bad", "Q", "ck.kalman_gain([[0.0, 1.0], [0.0, 0.0]], [[1.0, 0.0]], np.zeros((2, 2)), [[1.0]])", "no_repeat"),
+    ("bad", "Q", "ck.kalman_gain(ROT @ np.diag([0.0, -1.0, -2.0]) @ ROT.T, np.array([[1.0, 0, 0]]) @ ROT.T, np.zeros((3, 3)), [[1.0]])", "no_repeat"),
     # systems of the neighbouring libraries: accepted, or the bridge named
     ("ok", "", "ck.simulate(CSYS, T11)"),
     ("ok", "", "ck.simulate(SSYS, T11)"),
@@ -147,6 +149,38 @@ CALLS = [
     ("bad", "A", "ck.is_stable(CTF)", "from_control|control.ss"),
     ("bad", "sys", "ck.simulate(control.ss(A2, B2, C2, 0, True), T11)", "from_control"),
     ("bad", "sys", "ck.observer_system(control.ss(A2, B2, C2, 0, 0.1), L2)"),
+    # more of the same kinds
+    ("bad", "method", "ck.simulate(vdp(1e4), np.linspace(0, 1000, 11), x0=[2.0, 0.0], method='RK23')"),
+    ("bad", "method", "ck.simulate_batch(vdp(1e4), np.linspace(0, 1000, 11), [[2.0, 0.0], [2.0, 0.1]])"),
+    ("bad", "A", "ck.place_observer(A200, B200.T, P200)"),
+    ("bad", "x", "ck.TrackingController(K2, lambda t: np.zeros(2), lambda t: np.zeros(1))(0.0, np.array([np.nan, 0.0]))"),
+    ("bad", "x_E", "ck.IntegralFeedback(np.array([[-1.0, -2.0, -3.0]]), 1)(0.0, np.array([0.0, np.nan, 0.0]))"),
+    ("bad", "dt", "ck.NonlinearSystem(lambda x, u: -x, n=1, dt=0)", "dt=None"),
+    ("bad", "dt", "ck.is_stable(A2, dt=0)", "dt=None"),
+    ("bad", "dt", "ck.kalman_gain(A2, C2, np.eye(2), [[1.0]], dt=0)", "dt=None"),
+    ("bad", "u_eq", "ck.find_equilibria(pend_f, n=2)"),
+    ("bad", "check_equilibrium", "ck.linearize(pend_f, [0.0, 0.0], [0.0], check_equilibrium=1)"),
+    ("bad", "A", "ck.symbolic_linear_flatness(np.float64(1.0), [[1.0]])"),
+    ("bad", "ax", "ck.plot_poles([-1.0], ax=3)"),
+    ("bad", "poles", "ck.place(A2, B2, [10**400, -1.0])"),
+    ("bad", "x0", "ck.simulate(ck.StateSpace(A2, B2, C2), T11, x0=[10**400, 0.0])"),
+    ("bad", "A", "ck.StateSpace([[10**400]])"),
+    ("bad", "T", "ck.poly_trajectory(10**400, [0.0], [1.0])"),
+    ("ok", "", "ck.white_noise(T11, 1.0, seed=10**400)"),   # numpy takes any integer as a seed
+    ("bad", "wn", "xp3.pair_poles(10**400, 0.7)"),
+    ("bad", "A", "ck.place_details(CSYS, B2, P2)", "from_control"),
+    ("bad", "sys2", "ck.feedback(CSYS, STF)", "from_scipy|to_ss"),
+    ("bad", "sys", "ck.observer_system(signal.StateSpace(A2 * 0.1, B2, C2, 0, dt=0.1), L2)"),
+    ("bad", "t", "ck.kalman_bucy(CSYS, T11[::-1], U11, Y11, np.eye(2), [[1.0]], np.eye(2), np.zeros(2))"),
+    ("bad", "T", "ck.similarity_transform(SSYS, np.ones((2, 2)))"),
+    ("bad", "values", "ck.symbolic_flat_maps('car_like', L=2.5).functions()[0]([1.0, 2.0])"),
+    ("bad", "variables", "ck.symbolic_jacobian(SYMF, [x1, 'x2'])"),
+    ("bad", "u", "ck.linearize_symbolic(SYMF, [x1, x2], 'u', x_eq=[0, 0])"),
+    ("bad", "samples", "ck.plan_flat_output(ck.pendulum_flatness(), 2.0, [0.0, 0.0], [1.0, 0.0]).plot(samples=10**12)"),
+    ("ok", "", "ck.simulate(vdp(1e4), np.linspace(0, 1000, 11), x0=[2.0, 0.0], method='Radau')"),
+    ("ok", "", "ck.place(A2 * 1e6, B2, P2)"),
+    ("ok", "", "ck.similarity_transform(ck.StateSpace(A2, B2, C2), [[1.0, 1.0], [0.0, 1e-4]])"),
+    ("ok", "", "ck.linearize(lambda x, u: np.array([(1.6 + x[0]) * 16.8 - 1.6 * 16.8]), [0.0])"),
 ]
 
 

@@ -343,7 +343,7 @@ def as_poles(poles, name: str = "poles", *, count: int) -> np.ndarray:
                          "e.g. [-1, -2].")
     try:
         arr = np.atleast_1d(np.asarray(poles, dtype=complex)).ravel()
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ValueError(f"{name} must be a list of numbers: received {_describe(poles)}.") from None
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} contains NaN or infinite entries: received {arr.tolist()!r}.")

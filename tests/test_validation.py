@@ -61,3 +61,8 @@ def test_dt_zero_points_to_dt_none(call):
     # issue 25: dt=0 (python-control's continuous time) was refused without the way out
     with pytest.raises(ValueError, match=r"^dt must be positive: received 0\.0(?s:.*)pass dt=None"):
         call()
+
+
+def test_poles_too_large_for_a_float_are_named():
+    with pytest.raises(ValueError, match=r"^poles must be a list of numbers"):
+        v.as_poles([10**400, -1.0], count=2)
