@@ -220,6 +220,10 @@ def _integrate_batch(model, t: np.ndarray, X0: np.ndarray, options: dict) -> np.
     from scipy.integrate import solve_ivp
     (n, k), m = X0.shape, model.sys.m
     f, u, last, calls = model.f, model.u_user, [t[0], X0], [0]
+    def first(z):  # the first initial state as a batch of one
+        return np.ravel(f(z[:, None], np.asarray(u(t[0], z[:, None]), dtype=float).reshape(m, 1)))
+
+    _check_explicit_work(first, t, X0[:, 0], options)
 
     def rhs(tk, flat):
         X = last[1] = flat.reshape(n, k)
@@ -760,14 +764,17 @@ _MAX_EXPLICIT_WORK = 1e6
 _MAX_EVALUATIONS = 1_000_000
 
 
-def _check_explicit_work(model, t: np.ndarray, x0: np.ndarray, options: dict) -> None:
-    """Refuse an explicit method whose stability limit alone asks for > 1e6 |lambda| t steps."""
+def _check_explicit_work(field, t: np.ndarray, x0: np.ndarray, options: dict) -> None:
+    """Refuse an explicit method whose stability limit alone asks for > 1e6 |lambda| t steps.
+
+    `field(x)` is dx/dt at t[0] (with the input applied); its Jacobian at x0 gives |lambda|.
+    """
     if options["method"] not in _EXPLICIT:
         return
     from .linearization import _jacobian
     try:
         with np.errstate(all="ignore"):
-            J = _jacobian(lambda z: model.f(z, model.u_fun(t[0], z)), x0, refine=False)
+            J = _jacobian(field, x0, refine=False)
             rate = float(np.abs(np.linalg.eigvals(J)).max())
     except Exception:  # f fails near x0: the guarded integration reports it
         return
@@ -801,7 +808,7 @@ def _integrate(model, t, x0, options: dict) -> np.ndarray:
     from scipy.integrate import solve_ivp
     f, u_fun, n, last = model.f, model.u_fun, model.sys.n, [t[0], x0]
     shape, ndarray, isfinite = (n,), np.ndarray, math.isfinite
-    _check_explicit_work(model, t, x0, options)
+    _check_explicit_work(lambda z: f(z, u_fun(t[0], z)), t, x0, options)
     calls = [0]
 
     def rhs(tk, xk):

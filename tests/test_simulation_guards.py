@@ -299,5 +299,8 @@ def test_stiffness_that_appears_later_stops_at_the_evaluation_bound(monkeypatch)
         with pytest.raises(ck.SimulationError, match=r"evaluated f 20,000 times and reached only t = "
                                                      r"[\d.]+ of 100(?s:.*)method='Radau'"):
             run()
+    # from x0 = [2, 0] the stiffness shows at the start: refused before any step, in a batch too
+    with pytest.raises(ck.SimulationError, match=r"cannot finish in bounded work"):
+        ck.simulate_batch(vdp, np.linspace(0, 100, 11), [[2.0, 0.0], [2.0, 0.1]])
     # the implicit methods are not stopped: Radau solves it in a few hundred steps
     assert ck.simulate(vdp, np.linspace(0, 100, 11), x0=[1.0, 0.0], method="Radau").x.shape == (11, 2)
