@@ -10,6 +10,7 @@ wrong, what was received and what was expected, e.g.::
 
 from __future__ import annotations
 
+import sys as _sys
 from typing import Callable
 
 import numpy as np
@@ -24,10 +25,13 @@ __all__ = [
     "is_uniform",
     "as_poles",
     "as_integer",
+    "as_dt",
     "as_text",
     "as_flag",
     "time_grid",
     "check_function_output",
+    "as_system",
+    "foreign_library",
 ]
 
 
@@ -60,7 +64,7 @@ def _is_complex(value) -> bool:
         # sympy numbers and matrices: complex when some entry has an imaginary part
         try:
             return bool(np.any(np.asarray(value, dtype=complex).imag != 0))
-        except (TypeError, ValueError):
+        except (TypeError, ValueError, OverflowError):
             return False
     return False
 
@@ -77,9 +81,48 @@ def _is_text(value) -> bool:
     return False
 
 
+def _type_name(value) -> str:
+    """The full name of value's type, e.g. ``control.statesp.StateSpace``."""
+    kind = type(value)
+    return kind.__qualname__ if kind.__module__ == "builtins" else f"{kind.__module__}.{kind.__qualname__}"
+
+
+def foreign_library(value) -> str | None:
+    """"python-control" or "scipy.signal" when `value` is a system object of that library, else None.
+
+    Only libraries already imported are looked at (an object of theirs cannot exist otherwise).
+    """
+    top = type(value).__module__.split(".")[0]
+    control = _sys.modules.get("control") if top == "control" else None
+    if control is not None and isinstance(value, getattr(control, "InputOutputSystem", ())):
+        return "python-control"
+    signal = _sys.modules.get("scipy.signal") if top == "scipy" else None
+    if signal is not None and isinstance(value, (signal.lti, signal.dlti)):
+        return "scipy.signal"
+    return None
+
+
+_BRIDGES = {"python-control": "StateSpace.from_control", "scipy.signal": "StateSpace.from_scipy"}
+
+
+def _refuse_system_as_matrix(value, name: str) -> None:
+    """A system passed where a matrix is wanted: say which matrix to take, or which bridge."""
+    library = foreign_library(value)
+    if library is None and type(value).__module__ == "coursekit.systems":
+        library = "coursekit"
+    if library is None:
+        return
+    bridge = f", or convert the system with {_BRIDGES[library]}(sys)" if library in _BRIDGES else ""
+    raise ValueError(
+        f"{name} must be a matrix: received a {library} system ({_type_name(value)}); pass its "
+        f"matrix, e.g. sys.{name if name in ('A', 'B', 'C', 'D') else 'A'}{bridge}."
+    )
+
+
 def _to_float_array(value, name: str) -> np.ndarray:
     if value is None:
         raise ValueError(f"{name} is missing: received None, expected a number or an array.")
+    _refuse_system_as_matrix(value, name)
     if _is_text(value):
         raise ValueError(
             f"{name} must contain real numbers: received the text {value!r}; type the numbers "
@@ -93,7 +136,7 @@ def _to_float_array(value, name: str) -> np.ndarray:
     try:
         # sympy matrices, nested lists and numbers all pass through np.asarray
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError) as err:
+    except (TypeError, ValueError, OverflowError) as err:
         raise ValueError(
             f"{name} must contain real numbers: received {_describe(value)} "
             f"that cannot be converted to a float array ({err})."
@@ -199,6 +242,21 @@ def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False
     return x
 
 
+def as_dt(value, name: str = "dt") -> float | None:
+    """A time base: None (continuous time) or a sampling period > 0.
+
+    0 is refused with a pointer to None: python-control writes continuous time as
+    dt=0, coursekit as dt=None.
+    """
+    if value is None:
+        return None
+    if as_scalar(value, name) == 0:
+        raise ValueError(f"{name} must be positive: received 0.0, but a sampling period is > 0; for a "
+                         f"continuous-time system pass {name}=None or leave {name} out (python-control "
+                         "writes continuous time as dt=0, coursekit as dt=None).")
+    return as_scalar(value, name, positive=True)
+
+
 def as_integer(value, name: str, *, minimum: int | None = None, why: str = "") -> int:
     """Return `value` as an int, checking it is a finite whole number (>= `minimum`)."""
     if isinstance(value, (bool, np.bool_)):
@@ -225,10 +283,28 @@ def as_text(value, name: str, *, expected: str = "a string") -> str:
     return value
 
 
-def time_grid(t_end, samples, *, t_end_name: str = "t_end") -> np.ndarray:
-    """``np.linspace(0, t_end, samples)`` after checking t_end > 0 and samples >= 2 (named)."""
+#: the most samples `time_grid` allocates (8 MB), and the longest span it covers by default
+MAX_SAMPLES = 10**6
+MAX_SPAN = 1e6
+
+
+def time_grid(t_end, samples, *, t_end_name: str = "t_end", max_span: float | None = MAX_SPAN) -> np.ndarray:
+    """``np.linspace(0, t_end, samples)`` after checking 0 < t_end <= max_span and 2 <= samples <= 10^6.
+
+    Each bound is checked before anything is allocated or integrated, and named
+    (a huge `samples` ran out of memory, a t_end of 1e300 made the solvers work
+    for ever); ``max_span=None`` for a span chosen elsewhere (a plan's horizon).
+    """
     t_end = as_scalar(t_end, t_end_name, positive=True)
     samples = as_integer(samples, "samples", minimum=2, why="a time grid needs a start and an end")
+    if samples > MAX_SAMPLES:
+        raise ValueError(f"samples must be at most {MAX_SAMPLES:,}: received {samples:,}, which would "
+                         f"need {8 * samples / 1e9:.3g} GB per curve; a figure shows no more than a few "
+                         "thousand points, so pass e.g. samples=1000.")
+    if max_span is not None and t_end > max_span:
+        raise ValueError(f"{t_end_name} is too large: a time span of {t_end:g} exceeds {max_span:g}, the "
+                         "longest these computations are meant for (seconds to minutes of motion); "
+                         f"pass a smaller {t_end_name}, or call simulate yourself for a long horizon.")
     return np.linspace(0.0, t_end, samples)
 
 
@@ -267,7 +343,7 @@ def as_poles(poles, name: str = "poles", *, count: int) -> np.ndarray:
                          "e.g. [-1, -2].")
     try:
         arr = np.atleast_1d(np.asarray(poles, dtype=complex)).ravel()
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ValueError(f"{name} must be a list of numbers: received {_describe(poles)}.") from None
     if not np.all(np.isfinite(arr)):
         raise ValueError(f"{name} contains NaN or infinite entries: received {arr.tolist()!r}.")
@@ -305,3 +381,64 @@ def check_function_output(func: Callable, args: tuple, name: str, *, size: int, 
     if arr.ndim > 1 and not (arr.ndim == 2 and 1 in arr.shape) or arr.size != size:
         raise ValueError(f"{name} returned shape {arr.shape}; expected {size} numbers ({what}).")
     return arr.ravel()
+
+
+_KINDS = {"any": "StateSpace or NonlinearSystem", "linear": "StateSpace", "nonlinear": "NonlinearSystem"}
+
+
+def _system_received(value) -> str:
+    """How a refused system argument is described: its time base, or its full type name."""
+    if isinstance(value, np.ndarray):
+        return f"a numpy array of shape {value.shape}"
+    if hasattr(value, "is_discrete") and type(value).__module__ == "coursekit.systems":
+        base, period = ("discrete", f" (dt={value.dt:g})") if value.is_discrete else ("continuous", "")
+        return f"a {base}-time {type(value).__name__}{period}"
+    return _type_name(value)
+
+
+def as_system(value, name: str = "sys", *, kind: str = "any", time: str = "", hint: str = ""):
+    """Return `value` as a coursekit system, converting python-control and scipy.signal ones.
+
+    `kind` is "any" (StateSpace or NonlinearSystem), "linear" (StateSpace) or
+    "nonlinear"; `time` is "", "continuous" or "discrete". A ``control.StateSpace``
+    or ``scipy.signal.StateSpace`` (also ``scipy.signal.lti(A, B, C, D)``) goes through
+    the bridges `StateSpace.from_control` / `from_scipy` (the same matrices (1.24) and
+    time base); one whose time base is unspecified (``dt=True``, or python-control's
+    ``dt=None``) is refused, because reading it as dt = 1 or as continuous is the user's
+    choice, and so is choosing the realization of a transfer function: both messages
+    name the bridge. Anything else raises ValueError naming `name`, the wanted kind and
+    the full type name of what was received, followed by `hint`.
+    """
+    from .systems import NonlinearSystem, StateSpace
+    library = foreign_library(value)
+    if library is not None:
+        value = _from_foreign(value, name, library)
+    wanted = (StateSpace, NonlinearSystem) if kind == "any" else \
+        StateSpace if kind == "linear" else NonlinearSystem
+    right_time = not time or isinstance(value, (StateSpace, NonlinearSystem)) and \
+        value.is_discrete == (time == "discrete")
+    if not isinstance(value, wanted) or not right_time:
+        base = f"{time}-time " if time else ""
+        raise ValueError(f"{name} must be a {base}{_KINDS[kind]}: received {_system_received(value)}"
+                         + (f"; {hint}" if hint else "."))
+    return value
+
+
+def _from_foreign(value, name: str, library: str):
+    """The coursekit StateSpace of a python-control / scipy.signal state-space object (bridges)."""
+    from .bridges import realization_hint
+    from .systems import StateSpace
+    module = _sys.modules["control" if library == "python-control" else "scipy.signal"]
+    bridge = _BRIDGES[library]
+    if not isinstance(value, module.StateSpace):
+        raise ValueError(f"{name} must be a state-space system: received {_type_name(value)}. "
+                         f"{realization_hint(value)} Then convert it with {bridge}(sys).")
+    dt = value.dt
+    if dt is True or (dt is None and library == "python-control"):
+        raise ValueError(
+            f"{name} is a {library} system whose time base is unspecified (dt={dt!r}): "
+            f"convert it with {bridge}(sys), which reads dt=True as a period of 1 and "
+            "python-control's dt=None as continuous time, or build it with dt=0 (continuous) "
+            "or the sampling period."
+        )
+    return getattr(StateSpace, bridge.split(".")[1])(value)

@@ -97,6 +97,18 @@ def _other_hint(sys, constructor: str) -> str:
     return f"Build one with {constructor}, or pass the matrices to StateSpace(A, B, C, D, dt)."
 
 
+def realization_hint(sys) -> str:
+    """How to get a state-space model from a python-control or SciPy system that is not one."""
+    if type(sys).__module__.split(".")[0] == "scipy":
+        return ("A transfer function has many state-space realizations: choose one, "
+                "e.g. `sys.to_ss()`, and pass that.")
+    if type(sys).__name__ == "TransferFunction":
+        return ("A transfer function has many state-space realizations: choose one, "
+                "e.g. `control.ss(G)`, and pass that.")
+    return ("Only linear state-space systems can be converted; linearize a nonlinear "
+            "system first (`sys.linearize(xeq, ueq)` or coursekit's `linearize`).")
+
+
 def from_control(sys):
     """coursekit `StateSpace` with the matrices and time base of a python-control system.
 
@@ -110,14 +122,8 @@ def from_control(sys):
 
     control = _import_control()
     if not isinstance(sys, control.StateSpace):
-        if isinstance(sys, control.TransferFunction):
-            hint = ("A transfer function has many state-space realizations: choose one, "
-                    "e.g. `control.ss(G)`, and pass that.")
-        elif isinstance(sys, control.InputOutputSystem):
-            hint = ("Only linear state-space systems can be converted; linearize a nonlinear "
-                    "system first (`sys.linearize(xeq, ueq)` or coursekit's `linearize`).")
-        else:
-            hint = _other_hint(sys, "control.ss(A, B, C, D)")
+        hint = realization_hint(sys) if isinstance(sys, control.InputOutputSystem) else \
+            _other_hint(sys, "control.ss(A, B, C, D)")
         raise _refuse(sys, "python-control", hint)
     if sys.nstates == 0:
         raise ValueError(
@@ -169,11 +175,8 @@ def from_scipy(sys):
     from .systems import StateSpace
 
     if not isinstance(sys, signal.StateSpace):
-        if isinstance(sys, (signal.lti, signal.dlti)):
-            hint = ("A transfer function has many state-space realizations: choose one, "
-                    "e.g. `sys.to_ss()`, and pass that.")
-        else:
-            hint = _other_hint(sys, "scipy.signal.StateSpace(A, B, C, D)")
+        hint = realization_hint(sys) if isinstance(sys, (signal.lti, signal.dlti)) else \
+            _other_hint(sys, "scipy.signal.StateSpace(A, B, C, D)")
         raise _refuse(sys, "scipy.signal", hint)
     return StateSpace(_copy(sys.A), _copy(sys.B), _copy(sys.C), _copy(sys.D),
                       dt=_dt_to_coursekit(sys.dt, "scipy.signal"))

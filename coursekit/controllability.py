@@ -66,7 +66,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import as_matrix, as_square
+from ._validation import as_matrix, as_square, as_system
 from .diagnostics import warn_accuracy
 from .systems import StateSpace
 
@@ -446,12 +446,27 @@ def ccf_transform(A, B) -> np.ndarray:
                                 purpose="a transform to the controllability canonical form")
 
 
+# cond(T) eps above 2e-6 (a millionth, as the checks of the pole placement): the transform warns
+_T_COND_WARN = 1e10
+
+
 def similarity_transform(sys: StateSpace, T) -> StateSpace:
-    """Change of coordinates z = T x (2.50): returns (T A T^-1, T B, C T^-1, D)."""
-    if not isinstance(sys, StateSpace):
-        raise ValueError(f"sys must be a StateSpace: received {type(sys).__name__}.")
+    """Change of coordinates z = T x (2.50): returns (T A T^-1, T B, C T^-1, D).
+
+    A singular T raises ValueError; a nearly singular one (condition number above 1e10,
+    errors above about 2e-6 of the matrices' size) gives an `AccuracyWarning`.
+    """
+    sys = as_system(sys, kind="linear", hint="build one with StateSpace(A, B, C, D).")
     T = as_square(T, "T", size=sys.n)
-    if np.linalg.cond(T) > 1 / np.finfo(float).eps:
+    condition = np.linalg.cond(T)
+    if condition > 1 / np.finfo(float).eps:
         raise ValueError("T is singular: a change of coordinates z = T x needs an invertible T.")
+    if condition > _T_COND_WARN:
+        warn_accuracy(
+            f"similarity_transform: T is nearly singular (condition number {condition:.2g}): T A T^-1 and "
+            f"C T^-1 carry errors of about {condition * np.finfo(float).eps:.1g} relative to their "
+            "size, so the new matrices are only approximately similar to the old ones. Choose "
+            "a better conditioned T (e.g. columns of similar length, not nearly parallel)."
+        )
     Tinv = np.linalg.inv(T)
     return StateSpace(T @ sys.A @ Tinv, T @ sys.B, sys.C @ Tinv, sys.D, dt=sys.dt, name=sys.name)

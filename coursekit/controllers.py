@@ -22,7 +22,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_square, as_vector
+from ._validation import as_matrix, as_scalar, as_square, as_system, as_vector
 from .diagnostics import UserFunctionError
 from .systems import NonlinearSystem, StateSpace, _checked_call, _float_array
 
@@ -56,6 +56,9 @@ def _states(x, n: int, name: str = "x", gain: str = "") -> np.ndarray:
         since = f", since {gain}" if gain else ""
         raise ValueError(f"{name} has shape {x.shape}: expected ({n},), one entry per state{since}, "
                          f"or ({n}, k) for a batch of k states as columns.")
+    if not np.isfinite(x).all():
+        raise ValueError(f"{name} contains NaN or infinite entries: received {_fmt(x)}; a control law "
+                         "needs a measured state (look for where the state became NaN or inf).")
     return x
 
 
@@ -239,9 +242,7 @@ def with_integrators(sys, C=None, r=None, *, integrators: int = 1) -> NonlinearS
     ``u=IntegralFeedback(K_E, q * p)``; to add an input disturbance d(t)
     as in (3.122), pass ``u=lambda t, x: controller(t, x) + d(t)``.
     """
-    if not isinstance(sys, (StateSpace, NonlinearSystem)) or sys.dt is not None:
-        raise ValueError(f"sys must be a continuous-time StateSpace or NonlinearSystem: "
-                         f"received {sys!r}.")
+    sys = as_system(sys, time="continuous")
     n = sys.n
     C = _output_matrix(C, n)
     p = C.shape[0]

@@ -13,9 +13,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_integer, as_matrix, as_scalar, as_vector
+from ._validation import as_dt, as_integer, as_matrix, as_scalar, as_system, as_vector, foreign_library
 from .diagnostics import UserFunctionError, call_user
-from .linearization import _function_name, _sympy_column
+from .linearization import _function_name, _input_size_explained, _sympy_column
 from .systems import NonlinearSystem, StateSpace, _raw_field
 
 __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
@@ -23,6 +23,8 @@ __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
 
 def _field(f, n=None, dt=None):
     """Return (func, name, n, m or None, dt) for a system or a bare function f(x, u)."""
+    if foreign_library(f):
+        f = as_system(f, "f")
     if isinstance(f, (NonlinearSystem, StateSpace)):
         return _raw_field(f), _function_name(getattr(f, "_f", f.f)), f.n, f.m, f.dt
     if not callable(f):
@@ -94,12 +96,13 @@ def find_equilibria(f, u_eq=None, guesses=None, *, n=None, dt=None, bounds=(-5.0
     if n is not None:
         n = as_integer(n, "n", minimum=1, why="the number of states of the system")
     func, name, n_sys, m, sys_dt = _field(f, n, dt)
-    dt = sys_dt if dt is None else as_scalar(dt, "dt", positive=True)
+    dt = sys_dt if dt is None else as_dt(dt)
     tol = as_scalar(tol, "tol", positive=True)
     u = _input(u_eq, m)
     X0 = _guesses(guesses, n_sys, bounds, count, seed)
     task = "find_equilibria, searching from the guess {}"
-    _check_at_guesses(func, name, dt, u, X0, task, inferred=n_sys is None)
+    with _input_size_explained(u_eq, u, "find_equilibria"):
+        _check_at_guesses(func, name, dt, u, X0, task, inferred=n_sys is None)
     from scipy.optimize import root
     found = []
     for x0 in X0:
@@ -246,7 +249,7 @@ def symbolic_equilibria(f, unknowns, *, discrete: bool = False):
     """
     import sympy as sp
     F = list(_sympy_column(f, "f"))
-    X = list(_sympy_column(unknowns, "unknowns")) if unknowns is not None else []
+    X = list(_sympy_column(unknowns, "unknowns", allow_empty=True)) if unknowns is not None else []
     if not X or not all(isinstance(v, sp.Symbol) for v in X):
         raise ValueError(f"unknowns must be a non-empty list of sympy symbols: received {unknowns!r}.")
     if discrete:

@@ -9,26 +9,23 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_scalar
+from ._validation import as_scalar, as_system
 from .systems import StateSpace
 
 __all__ = ["cascade", "feedback"]
 
 
-def _linear_pair(sys1, sys2, *, purpose: str) -> float | None:
-    """Check that sys1, sys2 are StateSpace of the same time kind; return their dt."""
-    for name, sys in (("sys1", sys1), ("sys2", sys2)):
-        if not isinstance(sys, StateSpace):
-            raise ValueError(
-                f"{name} must be a StateSpace for {purpose}: received {type(sys).__name__}. "
-                "Combinations of nonlinear systems are written by hand as one NonlinearSystem."
-            )
+def _linear_pair(sys1, sys2, *, purpose: str) -> tuple[StateSpace, StateSpace, float | None]:
+    """(sys1, sys2, dt): both as StateSpace (`as_system`), checked to share one time base."""
+    sys1, sys2 = (as_system(sys, name, kind="linear", hint=f"{purpose} combines linear systems; "
+                            "combinations of nonlinear systems are written by hand as one NonlinearSystem.")
+                  for name, sys in (("sys1", sys1), ("sys2", sys2)))
     if sys1.dt != sys2.dt:
         raise ValueError(
             f"sys1 and sys2 must both be continuous or both discrete with the same dt: "
             f"received dt={sys1.dt} and dt={sys2.dt}."
         )
-    return sys1.dt
+    return sys1, sys2, sys1.dt
 
 
 def _check_sizes(sys_from: StateSpace, sys_to: StateSpace, from_name: str, to_name: str) -> None:
@@ -54,7 +51,7 @@ def cascade(sys1, sys2) -> StateSpace:
     this is (1.38). The other order of (1.39) is ``cascade(sys2, sys1)``,
     whose state is then ``[x2; x1]``.
     """
-    dt = _linear_pair(sys1, sys2, purpose="cascade")
+    sys1, sys2, dt = _linear_pair(sys1, sys2, purpose="cascade")
     _check_sizes(sys1, sys2, "sys1", "sys2")
     A1, B1, C1, D1 = sys1.A, sys1.B, sys1.C, sys1.D
     A2, B2, C2, D2 = sys2.A, sys2.B, sys2.C, sys2.D
@@ -81,7 +78,7 @@ def feedback(sys1, sys2, sign: float = +1) -> StateSpace:
     otherwise). With ``C1 = I, C2 = I, D1 = D2 = 0`` the matrix of the result
     is ``[[A1, B1], [B2, A2]]``, i.e. (1.40).
     """
-    dt = _linear_pair(sys1, sys2, purpose="feedback")
+    sys1, sys2, dt = _linear_pair(sys1, sys2, purpose="feedback")
     sign = as_scalar(sign, "sign")
     if sign not in (1.0, -1.0):
         raise ValueError(f"sign must be +1 or -1: received {sign!r}.")

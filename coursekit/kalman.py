@@ -52,7 +52,7 @@ from typing import Callable
 import numpy as np
 
 from .diagnostics import UserFunctionError, call_user_fast, warn_accuracy
-from ._validation import as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
+from ._validation import as_dt, as_scalar, as_series, as_square, as_system, as_time_grid, as_vector, is_uniform
 from .linearization import _jacobian, _perturbed, _quotients
 from .observability import _obs_pair
 from .simulation import SimulationResult, _agrees_column_by_column, lti_step_matrices
@@ -169,8 +169,7 @@ def kalman_gain(A, C, Q, R, *, dt=None) -> tuple[np.ndarray, np.ndarray]:
     off by more than rounding explains.
     """
     A, C, Q, R = _gain_inputs(A, C, Q, R)
-    if dt is not None:
-        dt = as_scalar(dt, "dt", positive=True)
+    dt = as_dt(dt)
     P = _solve_riccati(A, C, Q, R, dt)
     if dt is None:
         # (4.87): L = P C^T R^{-1}
@@ -283,10 +282,11 @@ def _modes_of(A, Q):
     return lam, V, driven
 
 
-def _fmt_mode(lam: complex) -> str:
-    if abs(lam.imag) <= 1e-12 * abs(lam):
-        return f"{lam.real:.4g}"
-    return f"{lam.real:.4g} ± {abs(lam.imag):.4g}j"
+def _fmt_mode(lam: complex, tol: float = 0.0) -> str:
+    """λ for a message; parts within `tol` (rounding at A's scale) are printed as the 0 they are."""
+    re = 0.0 if abs(lam.real) <= tol else lam.real
+    im = 0.0 if abs(lam.imag) <= max(tol, 1e-12 * abs(lam)) else abs(lam.imag)
+    return f"{re:.4g}" if im == 0.0 else f"{re:.4g} ± {im:.4g}j"
 
 
 def _mode_reason(A, C, lam, v, dt, tol, closed_loop: bool, driven: bool) -> str | None:
@@ -295,22 +295,23 @@ def _mode_reason(A, C, lam, v, dt, tol, closed_loop: bool, driven: bool) -> str 
     margin = -lam.real if dt is None else 1.0 - abs(lam)
     kind = where if abs(margin) <= tol else "unstable"
     v = v / v[np.argmax(np.abs(v))]
-    shown = np.array2string(v.real if np.isrealobj(v) or not np.abs(v.imag).any() else v,
-                            precision=3, suppress_small=True)
+    shown = np.array2string((v.real if np.isrealobj(v) or not np.abs(v.imag).any() else v) + 0.0,
+                            precision=3, suppress_small=True)   # + 0.0: no "-0."
+    lam_text = _fmt_mode(lam, tol)
     if np.linalg.norm(C @ v) <= 1e-8 * np.linalg.norm(C, 2) * np.linalg.norm(v):
-        return (f"the mode λ = {_fmt_mode(lam)} of A (eigenvector {shown}) is {kind} and not "
+        return (f"the mode λ = {lam_text} of A (eigenvector {shown}) is {kind} and not "
                 "observable through C (C v = 0): y carries no trace of it, so no gain L can "
                 "move it ((A, C) is not detectable). Measure it (add a row to C that sees "
                 "this mode) or remove it from the model.")
     if kind == where and not driven:
-        return (f"the mode λ = {_fmt_mode(lam)} of A (eigenvector {shown}) lies {where} and the "
+        return (f"the mode λ = {lam_text} of A (eigenvector {shown}) lies {where} and the "
                 "process noise Q does not drive it: the model then claims this undamped mode "
                 "is known exactly, the steady-state gain leaves it uncorrected and the "
                 "estimation error never decays. Let Q act on it (e.g. Q = q * np.eye(n) with "
                 "a small q > 0), or use the time-varying filter, whose gain decays.")
     if closed_loop:
         return (f"the solver returned a solution that is not stabilizing (A - L C has the "
-                f"unstable eigenvalue {_fmt_mode(lam)}): the equation is too badly conditioned; "
+                f"unstable eigenvalue {lam_text}): the equation is too badly conditioned; "
                 "check the units of Q and R, or rescale the states.")
     return None
 
@@ -326,10 +327,13 @@ def _no_stabilizing_solution(A, C, dt, lam, V, driven=None, *, solver: str = "",
     """
     driven = np.zeros(lam.size, bool) if driven is None else driven
     _, _, tol = _unstable_modes(A, dt)
-    reasons = []
+    reasons, seen = [], []
     for k in range(lam.size):
-        if lam[k].imag < 0:                                  # one of each conjugate pair
+        # one of each conjugate pair, and one of a repeated eigenvalue (a Jordan block, whose
+        # eigenvectors coincide: the same paragraph twice)
+        if lam[k].imag < 0 or any(abs(lam[k] - other) <= max(tol, 1e-8 * abs(other)) for other in seen):
             continue
+        seen.append(lam[k])
         margin = -lam[k].real if dt is None else 1.0 - abs(lam[k])
         if not closed_loop and margin > tol:                 # a stable mode of A is harmless
             continue
@@ -632,8 +636,22 @@ def _estimate_pass(sys, G, w, x0, steps):
     return np.vstack([x0, after[last]])
 
 
+# RK4's error falls like h^4: 1000 steps per sample interval are 1e-12 of one step's error, and
+# more only cost time in proportion (10^9 of them made the filters run for hours)
+_MAX_SUBSTEPS = 1000
+
+
 def _substeps(substeps) -> int:
-    return int(as_scalar(substeps, "substeps", positive=True, integer=True))
+    """`substeps` checked: a whole number from 1 to _MAX_SUBSTEPS."""
+    k = int(as_scalar(substeps, "substeps", positive=True, integer=True))
+    if k > _MAX_SUBSTEPS:
+        raise ValueError(
+            f"substeps must be at most {_MAX_SUBSTEPS}: received {k}. RK4's error falls like the "
+            f"fourth power of the step, so {_MAX_SUBSTEPS} steps per sample are already exact to "
+            "rounding for any smooth model, and more only cost time; the step also shrinks by "
+            "itself where P changes fast. For a finer estimate, sample y on a finer grid t."
+        )
+    return k
 
 
 def _initial_estimate(x0, n: int) -> np.ndarray:
@@ -659,11 +677,10 @@ def kalman_bucy(sys, t, u, y, Q, R, P0, x0, *, substeps: int = 1) -> KalmanResul
     docstring). As t grows P(t) tends to the solution of `kalman_gain`.
 
     Returns a `KalmanResult` (estimate, P(t), L(t)). `substeps` RK4 steps
-    (at least) are taken between samples.
+    (at least; 1 to 1000, ValueError beyond) are taken between samples.
     """
-    if not isinstance(sys, StateSpace) or sys.is_discrete:
-        raise ValueError(f"sys must be a continuous-time StateSpace: received {sys!r}; "
-                         "for a NonlinearSystem use extended_kalman_filter.")
+    sys = as_system(sys, kind="linear", time="continuous",
+                    hint="for a NonlinearSystem use extended_kalman_filter.")
     t, u, y = _records(t, u, y, sys.m)
     if y.shape[1] != sys.p:
         raise ValueError(f"y has the wrong number of columns: received {y.shape[1]}, "
@@ -791,9 +808,7 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
     (non-finite x̂ or P) raises RuntimeError with the time; the number of
     RK4 steps per sample interval is bounded, so no call can hang.
     """
-    if not isinstance(sys, NonlinearSystem) or sys.is_discrete:
-        raise ValueError(f"sys must be a continuous-time NonlinearSystem: received {sys!r}; "
-                         "for a StateSpace use kalman_bucy.")
+    sys = as_system(sys, kind="nonlinear", time="continuous", hint="for a StateSpace use kalman_bucy.")
     t, u, y = _records(t, u, y, sys.m)
     x0 = _initial_estimate(x0, sys.n)
     _user(_raw_field(sys), "f")(x0, u[0], t[0])
@@ -868,8 +883,7 @@ def simulate_with_noise(sys, t, u=None, x0=None, *, Q, R, seed=None) -> Simulati
     `u` is None or an array (N, m); `t` must be uniform. Deterministic for a
     given `seed` (int or ``numpy.random.Generator``): w is drawn first, then v.
     """
-    if not isinstance(sys, (StateSpace, NonlinearSystem)) or sys.is_discrete:
-        raise ValueError(f"sys must be a continuous-time StateSpace or NonlinearSystem: received {sys!r}.")
+    sys = as_system(sys, time="continuous")
     t = as_time_grid(t, "t")
     dt = _uniform_step(t)
     n, N = sys.n, t.size

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_series
+from ._validation import as_series, as_system
 from .kalman import KalmanResult, _covariance, _initial_estimate
 from .systems import StateSpace
 
@@ -94,9 +94,8 @@ def discrete_kalman_filter(sys, y, u=None, *, Q, R, P0, x0) -> KalmanResult:
     semidefinite in floating point. Raises RuntimeError when the estimate or P
     stops being finite (an unstable model with huge data), naming the sample.
     """
-    if not isinstance(sys, StateSpace) or not sys.is_discrete:
-        raise ValueError(f"sys must be a discrete-time StateSpace (dt set): received {sys!r}; "
-                         "sample a continuous model first (exact: expm of A dt), or use "
+    sys = as_system(sys, kind="linear", time="discrete",
+                    hint="sample a continuous model first (exact: expm of A dt), or use "
                          "kalman_bucy for continuous time.")
     y, u = _sampled_data(sys, y, u)
     Q, R, P0, x0 = _weights(sys, Q, R, P0, x0)

@@ -1,7 +1,8 @@
 """Linear approximation of a nonlinear system around an equilibrium (section 3.4.2).
 
 * `linearize(f, x_eq, u_eq)` returns the Jacobians A = df/dx and B = df/du at
-  (x*, u*) (3.80), computed numerically: central differences over a ladder of
+  (x*, u*) (3.80), computed numerically: exact to rounding along the directions
+  in which f is affine; elsewhere central differences over a ladder of
   steps, refined by Richardson extrapolation, the most accurate one chosen by
   its error estimate (Ridders' method), so the accuracy does not depend on
   where the equilibrium lies (a pendulum that has turned 1000 times);
@@ -15,12 +16,13 @@ The linear model describes the deviations dx = x - x*, du = u - u* (3.61),
 
 from __future__ import annotations
 
+from contextlib import contextmanager
 from functools import cache
 from typing import Callable
 
 import numpy as np
 
-from ._validation import _is_complex, as_scalar, as_vector
+from ._validation import _is_complex, as_dt, as_flag, as_scalar, as_system, as_vector, foreign_library
 from .diagnostics import call_user, warn_accuracy
 from .systems import NonlinearSystem, StateSpace, _raw_field
 
@@ -35,6 +37,8 @@ def _function_name(func: Callable, role: str = "f") -> str:
 
 def _vector_field(f, x_eq, u_eq):
     """Return (func, name, x, u, n, m, dt): the user's f(x, u), how to name it, and the checked point."""
+    if foreign_library(f):
+        f = as_system(f, "f")
     if isinstance(f, (NonlinearSystem, StateSpace)):
         n, m, dt = f.n, f.m, f.dt
         x = as_vector(x_eq, "x_eq", size=n, why=f"one per state of the {n}-state system")
@@ -182,8 +186,70 @@ def _ridders_column(D: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, float
     return best, best_err
 
 
-def _column(g: Callable, z: np.ndarray, k: int, q: int) -> tuple[np.ndarray, float]:
-    """(dg/dz_k, error estimate) from the absolute ladders, or the relative one where it agrees.
+# A column along which g is affine (a straight line to rounding) is the same quotient at every
+# step, and the largest step rounds least: it is taken from three steps (powers of two of the
+# point's scale, its golden-ratio fraction, and 2^-10 of it) when their quotients agree and the
+# second differences vanish to _AFFINE_RTOL of the column's size, plus their rounding.
+_AFFINE_RTOL = 1e-12
+_AFFINE_STEPS = (1.0, _OTHER, 2.0 ** -10)
+# the rounding of a difference: a few eps of the values involved, with room for the rounding
+# of the arguments and of intermediate results inside g
+_ROUNDING = 64 * _EPS
+
+
+def _affine_column(g: Callable, z: np.ndarray, k: int, q: int,
+                   scale: float) -> tuple[np.ndarray, float] | None:
+    """(dg/dz_k, error estimate) when g is affine along e_k at the scale of the point, else None.
+
+    The steps are h = s * (1, 0.618..., 2^-10), s = 2^round(log2 max(scale, |z|)) / 4
+    (`scale`: the size of the whole point, x and u, whose rounding inside g a
+    step much smaller than it would magnify); for each, the central difference
+    D(h) must equal D(s) to _AFFINE_RTOL |D(s)| s / h, and g(z + h e_k) +
+    g(z - h e_k) - 2 g(z) must vanish to 8 _AFFINE_RTOL |D(s)| s, plus the
+    rounding of the values (rounding inside g is the same absolute error at
+    every step, hence the factors s / h and s). Then D(s) is exact to rounding
+    (no truncation error on a straight line), whatever the scale of the
+    coefficients; for a smooth f that passes, its error is below ~1e-11.
+    """
+    top = 2.0 ** np.round(np.log2(max(scale, float(np.abs(z).max())))) / 4
+    with np.errstate(all="ignore"):
+        center = _probe(g, z)
+        rows = [_sides(g, z, k, top * factor) for factor in _AFFINE_STEPS]
+    if center is None or center.size != q or any(row is None or row[0].size != q for row in rows):
+        return None
+    with np.errstate(all="ignore"):
+        quotients = [(plus - minus) / width for plus, minus, width in rows]
+        size = float(np.abs(quotients[0]).max())
+        worst = 0.0
+        for (plus, minus, width), D in zip(rows, quotients):
+            # rounding inside g (intermediate values larger than g's) is the same at every step, so
+            # its share of D grows like 1 / width: the tolerances grow alike, from the top step's
+            rounding = _ROUNDING * (np.abs(plus) + np.abs(minus) + 2 * np.abs(center) + abs(z[k]) * np.abs(D))
+            curvature = np.abs(plus + minus - 2 * center)
+            spread = np.abs(D - quotients[0])
+            if not (np.all(curvature <= _AFFINE_RTOL * size * 8 * top + rounding)
+                    and np.all(spread <= _AFFINE_RTOL * size * 2 * top / width + rounding / width)):
+                return None
+            worst = max(worst, float(spread.max()))
+    plus, minus, width = rows[0]
+    own = 2 * _EPS * float((np.abs(plus) + np.abs(minus) + abs(z[k]) * np.abs(quotients[0])).max()) / width
+    return quotients[0], max(own, worst)
+
+
+def _sides(g: Callable, z: np.ndarray, k: int, h: float):
+    """(g(z + h e_k), g(z - h e_k), the step actually taken), or None where g fails or is not finite."""
+    plus, minus = z.copy(), z.copy()
+    plus[k] += h
+    minus[k] -= h
+    values = [_probe(g, point) for point in (plus, minus)]
+    if any(v is None or not np.all(np.isfinite(v)) or v.size != values[0].size for v in values):
+        return None
+    return values[0], values[1], plus[k] - minus[k]
+
+
+def _column(g: Callable, z: np.ndarray, k: int, q: int, scale: float) -> tuple[np.ndarray, float]:
+    """(dg/dz_k, error estimate): exact where g is affine along e_k (`_affine_column`), else
+    from the absolute ladders, or the relative one where it agrees.
 
     The tableau's own estimate can be fooled by noise or a kink (a lucky
     agreement of two entries), so a second absolute ladder on other points
@@ -191,6 +257,9 @@ def _column(g: Callable, z: np.ndarray, k: int, q: int) -> tuple[np.ndarray, flo
     well, and the two results' disagreement is a lower bound of the error
     (`_agreed`).
     """
+    affine = _affine_column(g, z, k, q, scale)
+    if affine is not None:
+        return affine
     J, err = _agreed([_quotient_ladder(g, z, k, q, _ABSOLUTE_TOP * scale) for scale in (1.0, _OTHER)])
     if abs(z[k]) > _RELATIVE:
         h0 = 2.0 ** np.round(np.log2(abs(z[k]))) / 4
@@ -223,12 +292,14 @@ def _agreed(ladders: list) -> tuple[np.ndarray, float]:
     return best, best_err
 
 
-def _ridders(g: Callable, z: np.ndarray, q: int) -> tuple[np.ndarray, np.ndarray]:
-    """(J, err): the Jacobian (q, n) of g at z by Ridders' method and each column's error estimate."""
+def _ridders(g: Callable, z: np.ndarray, q: int, scale: float = 1.0) -> tuple[np.ndarray, np.ndarray]:
+    """(J, err): the Jacobian (q, n) of g at z by Ridders' method and each column's error estimate.
+
+    Columns along which g is affine are exact (`_affine_column`, at least `scale` wide)."""
     J = np.full((q, z.size), np.nan)
     err = np.full(z.size, np.inf)
     for k in range(z.size):
-        J[:, k], err[k] = _column(g, z, k, q)
+        J[:, k], err[k] = _column(g, z, k, q, scale)
     return J, err
 
 
@@ -253,13 +324,13 @@ _JACOBIAN_RTOL = 1e-7
 
 
 def _checked_jacobian(g: Callable, z: np.ndarray, q: int, *, symbol: str, variable: str,
-                      name: str, checked: Callable) -> np.ndarray:
+                      name: str, checked: Callable, scale: float = 1.0) -> np.ndarray:
     """Ridders' Jacobian of g at z; raises on NaN, warns when a column is not accurate.
 
     `checked(z, where)` evaluates the same function through `call_user`: for a
     column without any usable step it re-raises what f did there, with context.
     """
-    J, err = _ridders(g, z, q)
+    J, err = _ridders(g, z, q, scale)
     for k in range(z.size):
         if not np.all(np.isfinite(J[:, k])):
             step = z.copy()
@@ -316,8 +387,12 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     A : (n, n) array  -- df/dx at (x*, u*)
     B : (n, m) array  -- df/du at (x*, u*) (m = 0 columns without input)
 
-    Accuracy: each column is the central difference (f(x + h e_k) - f(x -
-    h e_k)) / 2h over a ladder of 30 steps halving from h = 1/4 (and, for
+    Accuracy: a column along which f is affine (a straight line: linear
+    dynamics, a bilinear term, an input that enters linearly) is exact to
+    rounding at any scale of the coefficients: the central difference is then
+    the same at every step, which three steps at the scale of (x*, u*) check
+    (`_affine_column`), and the largest is taken. Every other column is the
+    central difference (f(x + h e_k) - f(x - h e_k)) / 2h over a ladder of 30 steps halving from h = 1/4 (and, for
     |x_k| > 16, a second ladder from |x_k| / 4, used where it agrees),
     extrapolated (Richardson, up to h^12) and chosen by its error estimate
     (Ridders' method), which is cross-checked against a second ladder on
@@ -335,24 +410,49 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     `UserFunctionError` (a ValueError) naming the function and the point.
     """
     func, name, x, u, n, m, sys_dt = _vector_field(f, x_eq, u_eq)
-    dt = sys_dt if dt is None else as_scalar(dt, "dt", positive=True)
+    dt = sys_dt if dt is None else as_dt(dt)
     tol = as_scalar(tol, "tol", positive=True)
+    check_equilibrium = as_flag(check_equilibrium, "check_equilibrium",
+                                hint="pass check_equilibrium=False to linearize around any point")
 
     def checked(xx, uu, where):
         return np.ravel(call_user(func, (xx, uu), name, where=where))
 
-    f0 = checked(x, u, f"at x_eq = {x.tolist()}, u_eq = {u.tolist()}")
+    with _input_size_explained(u_eq, u, "linearize"):
+        f0 = checked(x, u, f"at x_eq = {x.tolist()}, u_eq = {u.tolist()}")
     if f0.size != n:
         raise ValueError(f"{name} returned {f0.size} numbers at x_eq; expected {n} (one per state).")
     if check_equilibrium:
         _check_equilibrium(f0, x, u, dt, tol, name)
-    # (3.80): A = df/dx (x*, u*),  B = df/du (x*, u*)
+    # (3.80): A = df/dx (x*, u*),  B = df/du (x*, u*); straight lines are tried at the point's scale
+    scale = max(1.0, float(np.abs(x).max(initial=0)), float(np.abs(u).max(initial=0)))
     A = _checked_jacobian(lambda z: func(z, u), x, n, symbol="A", variable="x", name=name,
-                          checked=lambda z, where: checked(z, u, where))
+                          checked=lambda z, where: checked(z, u, where), scale=scale)
     B = (_checked_jacobian(lambda w: func(x, w), u, n, symbol="B", variable="u", name=name,
-                           checked=lambda w, where: checked(x, w, where))
+                           checked=lambda w, where: checked(x, w, where), scale=scale)
          if m else np.zeros((n, 0)))
     return A, B
+
+
+@contextmanager
+def _input_size_explained(u_eq, u: np.ndarray, task: str):
+    """Turn an IndexError of the user's f at the first call into "u_eq is missing / too short".
+
+    f(x, u) that reads u[0] fails with the student's own IndexError when u_eq
+    was left out (u is then empty); the message says which argument to pass.
+    """
+    from .diagnostics import UserFunctionError
+    try:
+        yield
+    except UserFunctionError as err:
+        if not isinstance(err.__cause__, IndexError):
+            raise
+        state = "is missing" if u_eq is None else f"may be too short ({u.size} entries)"
+        raise ValueError(
+            f"u_eq {state}: {err}. Pass {task} the input u* with one entry per input that f reads "
+            "(f uses u[0], u[1], ...), e.g. u_eq=[0.0]; if f reads no input, check that each state "
+            "has its entry in x."
+        ) from err
 
 
 def _check_equilibrium(f0, x, u, dt, tol, name: str = "f") -> None:
@@ -393,7 +493,7 @@ def linearize_symbolic(f, x, u=None, x_eq=None, u_eq=None):
     """
     import sympy as sp
     X = _sympy_column(x, "x")
-    U = _sympy_column(u, "u") if u is not None else sp.zeros(0, 1)
+    U = _sympy_column(u, "u", allow_empty=True) if u is not None else sp.zeros(0, 1)
     if x_eq is None:
         raise ValueError("x_eq is missing: pass the equilibrium as a list, e.g. [sp.pi, 0].")
     subs = dict(zip(X, _values(x_eq, len(X), "x_eq")))
@@ -406,15 +506,22 @@ def linearize_symbolic(f, x, u=None, x_eq=None, u_eq=None):
     return A, B
 
 
-def _sympy_column(values, name: str):
+def _sympy_column(values, name: str, *, allow_empty: bool = False):
+    """`values` (a list or sympy Matrix of expressions) as a sympy column; text and (unless
+    `allow_empty`) an empty list raise ValueError naming `name`."""
     import sympy as sp
-    if isinstance(values, str):
-        raise ValueError(f"{name} must be a list of sympy expressions: received the text {values!r}; "
+    texts = [values] if isinstance(values, str) else \
+        [v for v in values if isinstance(v, str)] if isinstance(values, (list, tuple)) else []
+    if texts:
+        raise ValueError(f"{name} must be a list of sympy expressions: received the text {texts[0]!r}; "
                          "build expressions from symbols, e.g. x1, x2 = sp.symbols('x1 x2').")
     try:
         M = sp.Matrix(values)
-    except (TypeError, ValueError, sp.SympifyError):
+    except (TypeError, ValueError, NotImplementedError, sp.SympifyError):
         raise ValueError(f"{name} must be a list of sympy expressions: received {values!r}.") from None
+    if len(M) == 0 and not allow_empty:
+        raise ValueError(f"{name} is empty: expected at least one expression, e.g. [x1, x2] "
+                         "from x1, x2 = sp.symbols('x1 x2').")
     if M.shape[1] != 1:
         M = M.reshape(len(M), 1)
     return M

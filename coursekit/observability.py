@@ -23,7 +23,7 @@ import numpy as np
 from ._validation import as_matrix, as_poles, as_square
 from .controllability import (_canonical_transform, _check_tol, _controllability, _ctrb,
                               _marginal_note, _Staircase)
-from .placement import _gain, _PoleMatch, _require_finite, _warn_if_missed, poly_from_roots
+from .placement import _gain, _PoleMatch, _require_finite, _warn_if_missed, check_size, poly_from_roots
 
 __all__ = [
     "NotObservableError",
@@ -242,6 +242,7 @@ def place_observer(A, C, poles) -> np.ndarray:
     """
     A, C = _obs_pair(A, C)
     poles = as_poles(poles, "poles", count=A.shape[0])
+    check_size(A.shape[0], C.shape[0], f"C has {C.shape[0]} rows")
     require_observable(A, C, purpose="placing every pole of the estimation error dynamics")
     # (4.84): L^T = place(A^T, C^T, P) in MATLAB's sign, i.e. L = -K^T in the course's
     K, _ = _gain(A.T, C.T, poles)

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_matrix, as_series
+from ._validation import as_matrix, as_series, as_system
 from .systems import StateSpace
 
 __all__ = [
@@ -34,12 +34,8 @@ __all__ = [
 
 
 def _plant(sys) -> StateSpace:
-    if not isinstance(sys, StateSpace) or sys.is_discrete:
-        raise ValueError(
-            f"sys must be a continuous-time StateSpace: received {sys!r}; the observers of "
-            "chapter 4 copy a linear plant (for a NonlinearSystem use extended_kalman_filter)."
-        )
-    return sys
+    return as_system(sys, kind="linear", time="continuous", hint="the observers of chapter 4 copy "
+                     "a linear plant (for a NonlinearSystem use extended_kalman_filter).")
 
 
 def _gain_L(L, sys: StateSpace) -> np.ndarray:

@@ -12,7 +12,7 @@ import numpy as np
 
 from ._validation import as_integer, as_matrix, as_text
 from .simulation import SimulationResult
-from .style import new_figure
+from .style import figure_for, new_figure
 
 __all__ = ["plot_response", "plot_state_plane", "plot_euler_comparison"]
 
@@ -206,10 +206,7 @@ def plot_state_plane(trajectories, *, states=(0, 1), labels=None, state_names=No
         f"x(0) = [{pts[0, 0]:g}, {pts[0, 1]:g}]" for pts, _ in items]
     if len(labels) != len(items):
         raise ValueError(f"labels has {len(labels)} entries, expected {len(items)} (one per trajectory).")
-    if ax is None:
-        fig, ax = new_figure(1, 1, figsize=figsize)
-    else:
-        fig = ax.figure
+    fig, ax = figure_for(ax, figsize=figsize)
     for k, ((pts, _), label) in enumerate(zip(items, labels)):
         color = f"C{k}"
         if numbered if numbered is not None else len(pts) <= 25:

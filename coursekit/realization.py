@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_scalar, as_vector
+from ._validation import as_scalar, as_system, as_vector
 from .systems import NonlinearSystem, StateSpace
 
 __all__ = ["ode_to_ss", "difference_to_ss", "euler_discretize"]
@@ -121,11 +121,7 @@ def euler_discretize(sys, Ts):
     discrete system can be unstable although the continuous one is stable
     (for x' = lambda x with lambda < 0 this happens when Ts > 2 / |lambda|).
     """
-    if not isinstance(sys, (StateSpace, NonlinearSystem)):
-        raise ValueError(
-            f"sys must be a StateSpace or NonlinearSystem: received {type(sys).__name__}; "
-            "build one with StateSpace(A, B, C, D) or NonlinearSystem(f, n, m)."
-        )
+    sys = as_system(sys, hint="build one with StateSpace(A, B, C, D) or NonlinearSystem(f, n, m).")
     Ts = as_scalar(Ts, "Ts", positive=True)
     if sys.is_discrete:
         raise ValueError(

@@ -33,7 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_series, as_square, as_time_grid, as_vector, is_uniform
+from ._validation import (as_matrix, as_scalar, as_series, as_square, as_system, as_time_grid, as_vector,
+                          is_uniform)
 from .diagnostics import UserFunctionError, call_user
 from .systems import NonlinearSystem, StateSpace, _checked_call, _raw_field
 
@@ -135,13 +136,11 @@ def simulate(sys, t, u=None, x0=None, *, rtol: float = 1e-9, atol: float = 1e-12
         eigenvalues of A (section 3.2.2). This is an error, not a warning: a
         result holding inf/NaN plots as a curve that silently stops, and
         whatever is computed from it is meaningless; the error says up to
-        which time the simulation is meaningful.
+        which time the simulation is meaningful. Also raised, naming `method`,
+        when the work would be unbounded: an explicit method on a stiff system
+        (refused before starting) or more than a million evaluations of f.
     """
-    if not isinstance(sys, (StateSpace, NonlinearSystem)):
-        raise ValueError(
-            f"sys must be a StateSpace or NonlinearSystem: received {type(sys).__name__}; "
-            "build one with StateSpace(A, B, C, D) or NonlinearSystem(f, n, m)."
-        )
+    sys = as_system(sys, hint="build one with StateSpace(A, B, C, D) or NonlinearSystem(f, n, m).")
     t = as_time_grid(t, "t", min_points=1 if sys.is_discrete else 2)
     x0 = np.zeros(sys.n) if x0 is None else as_vector(
         x0, "x0", size=sys.n, why=f"one per state of the {sys.n}-state system")
@@ -198,8 +197,8 @@ def simulate_batch(sys, t, x0s, u=None, *, rtol: float = 1e-9, atol: float = 1e-
     and at every evaluation; a failure names the function, the time and
     the trajectory.
     """
-    if not isinstance(sys, (StateSpace, NonlinearSystem)) or sys.is_discrete:
-        raise ValueError("sys must be a continuous-time StateSpace or NonlinearSystem for simulate_batch.")
+    sys = as_system(sys, time="continuous", hint="simulate_batch integrates an ODE; for a "
+                    "discrete-time system call simulate once per initial state.")
     t = as_time_grid(t, "t")
     X0 = as_matrix(x0s, "x0s", cols=sys.n, cols_why="one column per state")
     n, k, m = sys.n, X0.shape[0], sys.m
@@ -217,14 +216,21 @@ def simulate_batch(sys, t, x0s, u=None, *, rtol: float = 1e-9, atol: float = 1e-
 
 
 def _integrate_batch(model, t: np.ndarray, X0: np.ndarray, options: dict) -> np.ndarray:
-    """The stacked ODE X' = f(X, u(t, X)), guarded like `_integrate`; (N, n k) on the grid t."""
+    """The stacked ODE X' = f(X, u(t, X)), guarded and bounded like `_integrate`; (N, n k) on the grid t."""
     from scipy.integrate import solve_ivp
     (n, k), m = X0.shape, model.sys.m
-    f, u, last = model.f, model.u_user, [t[0], X0]
+    f, u, last, calls = model.f, model.u_user, [t[0], X0], [0]
+    def first(z):  # the first initial state as a batch of one
+        return np.ravel(f(z[:, None], np.asarray(u(t[0], z[:, None]), dtype=float).reshape(m, 1)))
+
+    _check_explicit_work(first, t, X0[:, 0], options)
 
     def rhs(tk, flat):
         X = last[1] = flat.reshape(n, k)
         last[0] = tk
+        calls[0] += 1
+        if calls[0] > _MAX_EVALUATIONS:
+            raise _work_exceeded(model.sys, options, tk, t)
         try:
             F = np.asarray(f(X, np.asarray(u(tk, X), dtype=float).reshape(m, k)), dtype=float)
             if F.size == n * k and _screen(F):
@@ -748,18 +754,68 @@ def _recurse_complex(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
     return x
 
 
+# The solver's work is bounded without a clock. An explicit method on a stiff system takes
+# steps of about 1 / |lambda| (its stability limit), so a fastest rate |lambda| of the Jacobian
+# at x0 times the time span above _MAX_EXPLICIT_WORK (about ten seconds of stepping) is refused
+# before starting; any run is stopped after _MAX_EVALUATIONS evaluations of f (the stiffness can
+# also appear later on the trajectory, as in the Van der Pol oscillator).
+_EXPLICIT = ("RK45", "RK23", "DOP853")
+_MAX_EXPLICIT_WORK = 1e6
+_MAX_EVALUATIONS = 1_000_000
+
+
+def _check_explicit_work(field, t: np.ndarray, x0: np.ndarray, options: dict) -> None:
+    """Refuse an explicit method whose stability limit alone asks for > 1e6 |lambda| t steps.
+
+    `field(x)` is dx/dt at t[0] (with the input applied); its Jacobian at x0 gives |lambda|.
+    """
+    if options["method"] not in _EXPLICIT:
+        return
+    from .linearization import _jacobian
+    try:
+        with np.errstate(all="ignore"):
+            J = _jacobian(field, x0, refine=False)
+            rate = float(np.abs(np.linalg.eigvals(J)).max())
+    except Exception:  # f fails near x0: the guarded integration reports it
+        return
+    span = float(t[-1] - t[0])
+    if rate * span > _MAX_EXPLICIT_WORK:
+        raise SimulationError(
+            f"method={options['method']!r} cannot finish in bounded work: the fastest mode of f at "
+            f"x0 has rate |lambda| = {rate:.3g}, so an explicit method needs steps of about "
+            f"1/|lambda| and roughly {rate * span / 4:.2g} of them over the {span:.3g} time units "
+            "of t. If that mode decays fast (a stiff system), pass method='Radau' or "
+            "method='LSODA', which take large steps there; if it oscillates, simulate a shorter "
+            "time span."
+        )
+
+
+def _work_exceeded(sys, options: dict, tk: float, t: np.ndarray) -> SimulationError:
+    return SimulationError(
+        f"the ODE solver (method={options['method']!r}) evaluated f {_MAX_EVALUATIONS:,} times "
+        f"and reached only t = {tk:.6g} of {t[-1]:.6g}: the system is stiff or very fast there. "
+        "Pass method='Radau' or method='LSODA' for a stiff system, or simulate a shorter time span."
+    )
+
+
 def _integrate(model, t, x0, options: dict) -> np.ndarray:
     """Integrate x' = f(x, u(t, x)) with solve_ivp, returning x on the grid t.
 
     Every evaluation is guarded (a plain call and one finiteness test, see
     `_Model`): NaN/inf would otherwise make the solver shrink its step for ever.
+    The work is bounded (`_check_explicit_work`, `_MAX_EVALUATIONS`).
     """
     from scipy.integrate import solve_ivp
     f, u_fun, n, last = model.f, model.u_fun, model.sys.n, [t[0], x0]
     shape, ndarray, isfinite = (n,), np.ndarray, math.isfinite
+    _check_explicit_work(lambda z: f(z, u_fun(t[0], z)), t, x0, options)
+    calls = [0]
 
     def rhs(tk, xk):
         last[0], last[1] = tk, xk
+        calls[0] += 1
+        if calls[0] > _MAX_EVALUATIONS:
+            raise _work_exceeded(model.sys, options, tk, t)
         try:
             dx = f(xk, u_fun(tk, xk))
             # the fast test of `_screen`, inlined: this runs at every evaluation

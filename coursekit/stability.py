@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_scalar, as_square
+from ._validation import as_dt, as_scalar, as_square, as_system, foreign_library
 from .systems import StateSpace
 
 __all__ = ["is_stable", "plot_poles", "format_poles"]
@@ -22,9 +22,10 @@ __all__ = ["is_stable", "plot_poles", "format_poles"]
 
 def _matrix_and_dt(A, dt):
     """Accept a StateSpace (its own dt unless dt is given) or a square matrix."""
-    if isinstance(A, StateSpace):
-        return A.A, A.dt if dt is None else as_scalar(dt, "dt", positive=True)
-    return as_square(A, "A"), None if dt is None else as_scalar(dt, "dt", positive=True)
+    if isinstance(A, StateSpace) or foreign_library(A):
+        sys = as_system(A, "A", kind="linear")
+        return sys.A, sys.dt if dt is None else as_dt(dt)
+    return as_square(A, "A"), as_dt(dt)
 
 
 def is_stable(A, dt=None) -> bool:
@@ -92,16 +93,9 @@ def plot_poles(poles, *, dt=None, ax=None, title: str | None = None):
     Returns ``(fig, ax)``.
     """
     sets = _as_pole_sets(poles)
-    dt = None if dt is None else as_scalar(dt, "dt", positive=True)
-    if ax is None:
-        from .style import new_figure
-        fig, ax = new_figure()
-    else:
-        from matplotlib.axes import Axes
-        if not isinstance(ax, Axes):
-            raise ValueError(f"ax must be a matplotlib Axes: received {type(ax).__name__}; "
-                             "leave it out to draw a new figure.")
-        fig = ax.figure
+    dt = as_dt(dt)
+    from .style import figure_for
+    fig, ax = figure_for(ax)
     everything = np.concatenate(list(sets.values()))
     reach = 1.25 * max(1.0, float(np.abs(everything.real).max(initial=0)),
                        float(np.abs(everything.imag).max(initial=0)))

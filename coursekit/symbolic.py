@@ -46,14 +46,28 @@ def _sym_matrix(value, name: str):
     if _is_complex(value):
         raise ValueError(f"{name} must be real: received complex entries; pass the real matrix "
                          "(complex numbers are only accepted as poles).")
+    dims = _dimensions(value)
+    if dims not in (1, 2):
+        raise ValueError(f"{name} must be a matrix (nested list or sympy Matrix): received "
+                         f"{type(value).__name__} with {dims} dimensions; write it as a list of rows, "
+                         "e.g. [[0, 1], [-k / m, -d / m]] (a 1x1 matrix is [[a]]).")
     try:
         M = sp.Matrix(value)
-    except (TypeError, ValueError, sp.SympifyError) as err:
+    except (TypeError, ValueError, NotImplementedError, sp.SympifyError) as err:
         raise ValueError(f"{name} must be a matrix (nested list or sympy Matrix): received "
                          f"{type(value).__name__} ({err}).") from None
     for entry in M:
         _check_real(entry, name)
     return M
+
+
+def _dimensions(value) -> int:
+    """The number of dimensions of a nested list, array or sympy Matrix (a scalar has 0)."""
+    import numpy as np
+    try:
+        return int(np.ndim(np.asarray(value, dtype=object)))
+    except (TypeError, ValueError):
+        return int(np.ndim(value))
 
 
 def _sym_pair(A, B):
@@ -101,19 +115,35 @@ class SymbolicFlatMaps:
     psi_u: object
 
     def functions(self):
-        """(psi_x, psi_u) as numerical functions of ``[F, F', ...]`` (numpy, via lambdify)."""
+        """(psi_x, psi_u) as numerical functions of ``[F, F', ...]`` (numpy, via lambdify).
+
+        Each takes `values`, one row per derivative order 0..r (``len(derivs)``) with
+        one entry per flat output (for one flat output a flat list ``[F, F', ...]``);
+        any other shape, NaN or text raises ValueError naming `values`.
+        """
         import numpy as np
         import sympy as sp
+
+        from ._validation import as_matrix
         flat = [s for row in self.derivs for s in row]
-        fx = sp.lambdify(flat, self.psi_x, "numpy")
-        fu = sp.lambdify(flat, self.psi_u, "numpy")
-        m = len(self.derivs[0])
+        orders, m = len(self.derivs), len(self.derivs[0])
 
-        def call(func, values):
-            args = [np.atleast_1d(np.asarray(values[k], dtype=float)) for k in range(len(self.derivs))]
-            return np.asarray(func(*[a[j] for a in args for j in range(m)]), dtype=float).ravel()
+        def numerical(psi, label: str):
+            func = sp.lambdify(flat, psi, "numpy")
+            free = sorted(map(str, psi.free_symbols - set(flat)))
 
-        return (lambda values: call(fx, values)), (lambda values: call(fu, values))
+            def call(values):
+                rows = as_matrix(values, "values", rows=orders, cols=m, cols_why="one per flat output",
+                                 rows_why=f"F and its derivatives up to order {orders - 1}")
+                if free:
+                    raise ValueError(
+                        f"{label} still contains the parameters {', '.join(free)} as symbols: give them "
+                        f"numbers, e.g. symbolic_flat_maps({self.name!r}, "
+                        + ", ".join(f"{p}=1.0" for p in free) + ").functions().")
+                return np.asarray(func(*rows.ravel()), dtype=float).ravel()
+            return call
+
+        return numerical(self.psi_x, "psi_x"), numerical(self.psi_u, "psi_u")
 
 
 def _derivative_symbols(order: int, m: int):

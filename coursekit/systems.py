@@ -13,14 +13,14 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_square, check_function_output
+from ._validation import as_dt, as_matrix, as_scalar, as_square, check_function_output
 from .diagnostics import UserFunctionError, call_user, call_user_fast
 
 __all__ = ["StateSpace", "NonlinearSystem"]
 
 
 def _check_dt(dt, name: str = "dt") -> float | None:
-    return None if dt is None else as_scalar(dt, name, positive=True)
+    return as_dt(dt, name)
 
 
 def _checked_call(func: Callable, args: tuple, name: str, *, size: int, what: str,

@@ -23,7 +23,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_integer, as_scalar, as_series, as_vector, time_grid
+from ._validation import as_integer, as_scalar, as_series, as_time_grid, as_vector, time_grid
 from .controllability import _pair, ccf_transform, charpoly
 from .diagnostics import call_user, warn_accuracy
 
@@ -47,7 +47,7 @@ def _input_time(t, horizon: float) -> float:
 
 def _plan_grid(horizon: float, samples) -> np.ndarray:
     """The plot grid of a plan: `samples` (>= 2) times on [0, T]."""
-    return time_grid(horizon, samples, t_end_name="T")
+    return time_grid(horizon, samples, t_end_name="T", max_span=None)
 
 
 def _derivative_order(k) -> int:
@@ -443,7 +443,7 @@ def plot_plan(t, x, u, *, title: str):
     (time-major; a 1-D `u` is one input). Raises ValueError naming the
     argument whose shape does not fit.
     """
-    t = as_vector(t, "t")
+    t = as_time_grid(t, "t")
     x = as_series(x, "x", samples=t.size)
     u = as_series(u, "u", samples=t.size)
     title = str(title)

@@ -9,7 +9,9 @@ the argument the error message must name. One line per case::
 whose message names `arg` (as a whole word; `also=` adds a regex the message
 must contain). `ok(target, label, call)`: a control, the same call with good
 arguments, which must not raise (so a bad case fails because of its one bad
-argument, not because the fixture is wrong). `feedback(target, label, call,
+argument, not because the fixture is wrong). `warns(target, label, call, arg)`:
+a call that may run but must not pass silently: a coursekit warning (turned
+into an error here) or a ValueError/TypeError naming `arg`. `feedback(target, label, call,
 says)`: a `check_*` exercise, which must print "Not yet" feedback matching
 `says` and return False, without raising. The `*_cases` helpers expand one
 line into the standard set of bad values for a matrix, a scalar, a list of
@@ -58,7 +60,7 @@ class Case:
     target: str      # the public name the case exercises ("place", "StateSpace.f", ...)
     label: str
     call: Callable
-    kind: str        # "bad", "ok" or "feedback"
+    kind: str        # "bad", "warns", "ok" or "feedback"
     pattern: str     # regex the message / printed feedback must contain
 
     @property
@@ -82,6 +84,13 @@ def bad(target: str, label: str, call: Callable, arg: str, *, also: str = "") ->
 def ok(target: str, label: str, call: Callable) -> None:
     """A control call with good arguments: must return without an exception or a warning."""
     CASES.append(Case(target, label, call, "ok", ""))
+
+
+def warns(target: str, label: str, call: Callable, arg: str, *, also: str = "") -> None:
+    """A call that may run but must not pass silently: a coursekit warning (the worker turns
+    warnings into errors) or a ValueError/TypeError, whose message names `arg` (and matches `also`)."""
+    pattern = _word(arg) + (rf"(?s:.*){also}" if also else "")
+    CASES.append(Case(target, label, call, "warns", pattern))
 
 
 def feedback(target: str, label: str, call: Callable, says: str = "") -> None:
@@ -773,6 +782,117 @@ bad("explorers.kalman_tuning_compute", "t_end zero", lambda: xp4.kalman_tuning_c
 bad("explorers.kalman_tuning_compute", "seed text", lambda: xp4.kalman_tuning_compute(0.0, 0.0, seed="a"), "seed")
 
 # ---------------------------------------------------------------------------
+# issue 25: the tail of bad inputs (hangs, raw internal errors, silent acceptances) and the
+# systems of python-control and scipy.signal
+
+def _control():
+    import control
+    return control
+
+
+def _signal():
+    import scipy.signal
+    return scipy.signal
+
+
+def _vdp(mu):
+    return ck.NonlinearSystem(lambda x, u: np.array([x[1], mu * (1 - x[0] ** 2) * x[1] - x[0]]), n=2)
+
+
+ok("simulate", "python-control system", lambda: ck.simulate(_control().ss(A2, B2, C2, 0), T11))
+ok("simulate", "scipy.signal system", lambda: ck.simulate(_signal().lti(A2, B2, C2, 0), T11))
+bad("simulate", "python-control transfer function", lambda: ck.simulate(_control().tf([1], [1, 2]), T11), "sys",
+    also=r"control\.xferfcn\.TransferFunction(?s:.*)StateSpace\.from_control")
+bad("simulate", "scipy.signal transfer function", lambda: ck.simulate(_signal().lti([1], [1, 2]), T11), "sys",
+    also=r"StateSpace\.from_scipy")
+bad("simulate", "python-control dt=True", lambda: ck.simulate(_control().ss(A2, B2, C2, 0, True), T11), "sys",
+    also=r"StateSpace\.from_control")
+bad("simulate", "stiff Van der Pol with DOP853", lambda: ck.simulate(_vdp(1e4), np.linspace(0, 1000, 11), x0=[2.0, 0.0],
+                                                                     method="DOP853"), "method", also="Radau")
+ok("is_stable", "python-control system", lambda: ck.is_stable(_control().ss(A2, B2, C2, 0)))
+bad("is_stable", "python-control transfer function", lambda: ck.is_stable(_control().tf([1], [1, 2])), "A",
+    also=r"StateSpace\.from_control")
+ok("similarity_transform", "python-control system", lambda: ck.similarity_transform(_control().ss(A2, B2, C2, 0), np.eye(2)))
+ok("cascade", "scipy.signal systems", lambda: ck.cascade(_signal().StateSpace(A2, B2, C2, 0), sys2()))
+ok("observer_system", "python-control system", lambda: ck.observer_system(_control().ss(A2, B2, C2, 0), L2))
+ok("kalman_bucy", "python-control system", lambda: _kb(sys=_control().ss(A2, B2, C2, 0)))
+ok("linearize", "python-control system", lambda: ck.linearize(_control().ss(A2, B2, C2, 0), [0.0, 0.0], [0.0]))
+for _name, _fn in (("place", lambda A: ck.place(A, B2, P2)), ("ctrb", lambda A: ck.ctrb(A, B2)),
+                   ("obsv", lambda A: ck.obsv(A, C2)), ("kalman_gain", lambda A: ck.kalman_gain(A, C2, Q2, R1))):
+    bad(_name, "A a python-control system", lambda _fn=_fn: _fn(_control().ss(A2, B2, C2, 0)), "A",
+        also=r"sys\.A(?s:.*)StateSpace\.from_control")
+bad("place", "200 states, 3 inputs", lambda: ck.place(np.random.default_rng(0).normal(size=(200, 200)),
+                                                      np.random.default_rng(1).normal(size=(200, 3)),
+                                                      -np.linspace(1, 20, 200)), "A", also="100 states")
+bad("place_observer", "200 states, 3 outputs", lambda: ck.place_observer(np.random.default_rng(0).normal(size=(200, 200)),
+                                                                          np.random.default_rng(1).normal(size=(3, 200)),
+                                                                          -np.linspace(1, 20, 200)), "A", also="100 states")
+bad("kalman_bucy", "substeps 10**9", lambda: _kb(substeps=10**9), "substeps", also="at most 1000")
+bad("extended_kalman_filter", "substeps 10**9", lambda: _ekf(substeps=10**9), "substeps", also="at most 1000")
+bad("kalman_gain", "Q zero, undriven double integrator",
+    lambda: ck.kalman_gain([[0.0, 1.0], [0.0, 0.0]], C2, np.zeros((2, 2)), R1), "Q", also=r"does not drive it")
+for _label, _call in (("msd_compute", lambda **kw: xp1.msd_compute(1.0, 0.5, 2.0, **kw)),
+                      ("pole_placement_compute", xp3.pole_placement_compute),
+                      ("upright_pendulum_compute", xp3.upright_pendulum_compute),
+                      ("integral_action_compute", xp3.integral_action_compute),
+                      ("observer_noise_compute", lambda **kw: xp4.observer_noise_compute(1.0, 0.1, **kw)),
+                      ("kalman_tuning_compute", lambda **kw: xp4.kalman_tuning_compute(0.0, 0.0, **kw))):
+    bad(f"explorers.{_label}", "t_end 1e300", lambda _call=_call: _call(t_end=1e300), "t_end")
+    bad(f"explorers.{_label}", "samples 10**12", lambda _call=_call: _call(samples=10**12), "samples")
+    bad(f"explorers.{_label}", "samples 1e300", lambda _call=_call: _call(samples=1e300), "samples")
+for _label, _call in (("planner_compute", xp2.planner_compute), ("robot_planner_compute", xp2.robot_planner_compute)):
+    bad(f"explorers.{_label}", "T 1e300", lambda _call=_call: _call(T=1e300), "T")
+    bad(f"explorers.{_label}", "samples 10**12", lambda _call=_call: _call(samples=10**12), "samples")
+bad("explorers.observer_noise_compute", "seed 10**400", lambda: xp4.observer_noise_compute(1.0, 0.1, seed=10**400), "seed")
+bad("OpenLoopPlan", "plot samples 10**12", lambda: _olc().plot(samples=10**12), "samples")
+bad("FlatPlan", "plot samples 10**12", lambda: _pflat().plot(samples=10**12), "samples")
+for _name, _fn in (("symbolic_ctrb", ck.symbolic_ctrb), ("symbolic_linear_flatness", ck.symbolic_linear_flatness)):
+    bad(_name, "A 0-d array", lambda _fn=_fn: _fn(np.array(1.0), [[1.0]]), "A")
+    bad(_name, "A 3-D array", lambda _fn=_fn: _fn(np.zeros((2, 2, 2)), B2), "A")
+    bad(_name, "B 3-D array", lambda _fn=_fn: _fn(A2, np.zeros((2, 1, 1))), "B")
+
+
+def _pendulum_maps(which=0, **params):
+    return ck.symbolic_flat_maps("pendulum", **(params or dict(m=1.0, l=1.0, g=9.81, d_theta=0.0))).functions()[which]
+
+
+ok("SymbolicFlatMaps", "functions called", lambda: (_pendulum_maps(0)([0.1, 0.2, 0.3]), _pendulum_maps(1)([0.1, 0.2, 0.3])))
+bad("SymbolicFlatMaps", "values too short", lambda: _pendulum_maps(0)([0.0]), "values")
+bad("SymbolicFlatMaps", "values a dict", lambda: _pendulum_maps(1)({"a": 1}), "values")
+bad("SymbolicFlatMaps", "values None", lambda: _pendulum_maps(0)(None), "values")
+bad("SymbolicFlatMaps", "values text", lambda: _pendulum_maps(0)("abc"), "values")
+bad("SymbolicFlatMaps", "values wrong columns", lambda: ck.symbolic_flat_maps("two_wheeled").functions()[0]([[0.0], [0.0], [0.0]]),
+    "values")
+bad("SymbolicFlatMaps", "parameters still symbols", lambda: ck.symbolic_flat_maps("pendulum").functions()[1]([0.1, 0.2, 0.3]),
+    "psi_u", also="d_theta, g, l, m")
+bad("plot_state_plane", "ax text", lambda: ck.plot_state_plane([result().x], ax="ax"), "ax")
+bad("plot_state_plane", "ax a number", lambda: ck.plot_state_plane([result().x], ax=3), "ax")
+bad("StateFeedback", "x NaN", lambda: ck.StateFeedback(K2)(0.0, np.array([np.nan, 0.0])), "x")
+bad("StateFeedback", "x inf", lambda: ck.StateFeedback(K2)(0.0, np.array([np.inf, 0.0])), "x")
+bad("TrackingController", "x NaN", lambda: ck.TrackingController(K2, lambda t: np.zeros(2), lambda t: np.zeros(1))(
+    0.0, np.array([np.nan, 0.0])), "x")
+bad("IntegralFeedback", "x_E NaN", lambda: ck.IntegralFeedback(K_E, 1)(0.0, np.array([0.0, np.nan, 0.0])), "x_E")
+bad("PendulumLinearizingController", "x NaN", lambda: ck.PendulumLinearizingController(P2)(0.0, np.array([np.nan, 0.0])), "x")
+for _label, _flag in (("text 'no'", "no"), ("None", None), ("1", 1)):
+    bad("linearize", f"check_equilibrium {_label}", lambda _flag=_flag: ck.linearize(pend_f, [0.0, 0.0], [0.0],
+                                                                                     check_equilibrium=_flag),
+        "check_equilibrium")
+bad("linearize", "u_eq missing for an f that reads u", lambda: ck.linearize(pend_f, [0.0, 0.0]), "u_eq", also="missing")
+bad("find_equilibria", "u_eq missing for an f that reads u", lambda: ck.find_equilibria(pend_f, n=2), "u_eq")
+bad("linearize", "dt zero", lambda: ck.linearize(linear_f, [0.0, 0.0], [0.0], dt=0), "dt", also=r"dt=None")
+bad("StateSpace", "dt zero points to None", lambda: ck.StateSpace(A2, B2, C2, dt=0), "dt", also=r"dt=None")
+bad("symbolic_jacobian", "variables empty", lambda: ck.symbolic_jacobian(_sym_f()[0], []), "variables")
+bad("symbolic_jacobian", "variables text", lambda: ck.symbolic_jacobian(_sym_f()[0], ["x1", "x2"]), "variables")
+bad("symbolic_jacobian", "f empty", lambda: ck.symbolic_jacobian([], _sym_f()[1]), "f")
+bad("linearize_symbolic", "x empty", lambda: ck.linearize_symbolic(_sym_f()[0], [], x_eq=[]), "x")
+bad("linearize_symbolic", "x text", lambda: ck.linearize_symbolic(_sym_f()[0], "x1 x2", x_eq=[0, 0]), "x")
+bad("plot_plan", "t decreasing", lambda: ck.plot_plan(T11[::-1], np.zeros((11, 2)), np.zeros((11, 1)), title="plan"), "t")
+warns("similarity_transform", "T of condition 1e15", lambda: ck.similarity_transform(sys2(), [[1.0, 1.0], [1.0, 1.0 + 1e-15]]),
+      "T", also="nearly singular")
+warns("place", "A scaled by 1e200", lambda: ck.place(A2 * 1e200, B2, P2), "poles", also="largest error")
+
+
+# ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"
 
 #: every check of the course (a new chapter's too) and the number of answers it takes
@@ -816,7 +936,8 @@ def _run_case(case: Case) -> dict:
         return dict(status="hang", detail=f"still running after {DEADLINE} s")
     except BaseException as err:  # anything a case raises is data for the verdict
         text = f"{type(err).__name__}: {err}"
-        if case.kind == "bad" and isinstance(err, (ValueError, TypeError)):
+        if case.kind == "bad" and isinstance(err, (ValueError, TypeError)) or \
+                case.kind == "warns" and isinstance(err, (ValueError, TypeError, ck.CoursekitWarning)):
             if re.search(case.pattern, str(err)):
                 return dict(status="pass", detail=text)
             return dict(status="fail", detail=f"message does not match {case.pattern!r}: {text}")
@@ -827,7 +948,7 @@ def _run_case(case: Case) -> dict:
     printed = out.getvalue()
     if case.kind == "ok":
         return dict(status="pass", detail="")
-    if case.kind == "bad":
+    if case.kind in ("bad", "warns"):
         return dict(status="fail", detail=f"no error; returned {type(value).__name__}")
     if isinstance(value, CheckResult) and not value and printed.startswith("Not yet") and re.search(case.pattern, printed):
         return dict(status="pass", detail=printed)

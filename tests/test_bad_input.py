@@ -139,7 +139,9 @@ def test_every_case_kind_can_fail():
               table.Case("probe", "wrong type", lambda: {}["x"], "bad", "x"),
               table.Case("probe", "wrong name", lambda: int("y"), "bad", table._word("x")),
               table.Case("probe", "Correct", lambda: print("Correct: yes") or True, "feedback", ""),
-              table.Case("probe", "warns", lambda: __import__("warnings").warn("w"), "ok", "")]
+              table.Case("probe", "warns", lambda: __import__("warnings").warn("w"), "ok", ""),
+              table.Case("probe", "no warning", lambda: None, "warns", "x"),
+              table.Case("probe", "foreign warning", lambda: __import__("warnings").warn("x"), "warns", "x")]
     for probe in probes:
         assert table._run_case(probe)["status"] == "fail", probe.label
     import signal

@@ -186,3 +186,84 @@ def test_bridge_makes_the_sign_of_K_concrete():
     K_ctrl = control.place(ctrl.A, ctrl.B, poles)
     # both solve the same 2x2 problem; 1e-9 leaves room for the two algorithms' rounding
     np.testing.assert_allclose(K_ck, -K_ctrl, rtol=1e-9)
+
+
+# --- every function that takes a system takes the neighbours' systems (issue 25) ---------
+
+A_2 = np.array([[0.0, 1.0], [-2.0, -3.0]])
+B_2, C_2, L_2, K_2 = np.array([[0.0], [1.0]]), np.array([[1.0, 0.0]]), np.array([[2.0], [1.0]]), np.array([[-1.0, -2.0]])
+T_11 = np.linspace(0.0, 1.0, 11)
+
+
+def _neighbours(dt=None):
+    """The same plant as coursekit, python-control and scipy.signal objects."""
+    A = A_2 if dt is None else np.eye(2) + 0.1 * A_2
+    return (ck.StateSpace(A, B_2, C_2, dt=dt), control.ss(A, B_2, C_2, 0, 0 if dt is None else dt),
+            signal.StateSpace(A, B_2, C_2, 0) if dt is None else signal.StateSpace(A, B_2, C_2, 0, dt=dt))
+
+
+_SYSTEM_CALLS = {
+    "simulate": lambda s: ck.simulate(s, T_11, u=np.ones((11, 1))).y,
+    "simulate_batch": lambda s: ck.simulate_batch(s, T_11, np.eye(2)),
+    "euler_discretize": lambda s: ck.euler_discretize(s, 0.1).A,
+    "cascade": lambda s: ck.cascade(s, s).A,
+    "feedback": lambda s: ck.feedback(s, s).A,
+    "similarity_transform": lambda s: ck.similarity_transform(s, [[1.0, 1.0], [0.0, 1.0]]).A,
+    "is_stable": lambda s: ck.is_stable(s),
+    "observer_system": lambda s: ck.observer_system(s, L_2).A,
+    "plant_with_observer": lambda s: ck.plant_with_observer(s, L_2).A,
+    "output_feedback": lambda s: ck.output_feedback(s, K_2, L_2).A,
+    "separation_eigenvalues": lambda s: ck.separation_eigenvalues(s, K_2, L_2),
+    "kalman_bucy": lambda s: ck.kalman_bucy(s, T_11, None, np.zeros((11, 1)), np.eye(2), [[1.0]],
+                                            np.eye(2), [1.0, 0.0]).x,
+    "simulate_with_noise": lambda s: ck.simulate_with_noise(s, T_11, Q=np.eye(2), R=[[1.0]], seed=1).y,
+    "with_integrators": lambda s: ck.with_integrators(s, C_2).f(np.ones(3), np.ones(1)),
+    "linearize": lambda s: np.hstack(ck.linearize(s, [0.0, 0.0], [0.0])),
+    "equilibrium_input": lambda s: ck.equilibrium_input(s, [0.0, 0.0]),
+}
+
+
+@pytest.mark.parametrize("call", _SYSTEM_CALLS.values(), ids=_SYSTEM_CALLS.keys())
+def test_every_function_taking_a_system_takes_python_control_and_scipy_ones(call):
+    ours, theirs_control, theirs_scipy = _neighbours()
+    expected = np.asarray(call(ours))
+    for other in (theirs_control, theirs_scipy, signal.lti(A_2, B_2, C_2, 0)):
+        np.testing.assert_array_equal(np.asarray(call(other)), expected)
+
+
+def test_discrete_systems_of_the_neighbours_keep_their_period():
+    ours, theirs_control, theirs_scipy = _neighbours(dt=0.1)
+    y = np.zeros((11, 1))
+    args = dict(Q=np.eye(2), R=[[1.0]], P0=np.eye(2), x0=[0.0, 0.0])
+    expected = ck.discrete_kalman_filter(ours, y, None, **args).x
+    for other in (theirs_control, theirs_scipy):
+        np.testing.assert_array_equal(ck.discrete_kalman_filter(other, y, None, **args).x, expected)
+        assert ck.simulate(other, np.arange(11) * 0.1).system.dt == 0.1
+
+
+@pytest.mark.parametrize("make, names", [
+    (lambda: control.tf([1], [1, 2]), r"control\.xferfcn\.TransferFunction(?s:.*)control\.ss\(G\)(?s:.*)StateSpace\.from_control"),
+    (lambda: signal.lti([1], [1, 2]), r"scipy\.signal\._ltisys\.TransferFunctionContinuous(?s:.*)to_ss(?s:.*)StateSpace\.from_scipy"),
+    (lambda: control.ss(A_2, B_2, C_2, 0, True), r"dt=True(?s:.*)StateSpace\.from_control"),
+    (lambda: signal.StateSpace(A_2, B_2, C_2, 0, dt=True), r"dt=True(?s:.*)StateSpace\.from_scipy"),
+])
+def test_what_would_hide_a_choice_is_refused_naming_the_bridge(make, names):
+    with pytest.raises(ValueError, match=names):
+        ck.simulate(make(), T_11)
+
+
+@pytest.mark.parametrize("call", [lambda s: ck.place(s, B_2, [-1, -2]), lambda s: ck.ctrb(s, B_2),
+                                  lambda s: ck.obsv(s, C_2), lambda s: ck.kalman_gain(s, C_2, np.eye(2), [[1.0]])])
+def test_a_system_given_for_a_matrix_names_the_matrix_and_the_bridge(call):
+    with pytest.raises(ValueError, match=r"A must be a matrix: received a python-control system "
+                                         r"\(control\.statesp\.StateSpace\); pass its matrix, e\.g\. sys\.A, "
+                                         r"or convert the system with StateSpace\.from_control"):
+        call(_neighbours()[1])
+
+
+def test_no_refusal_names_the_refused_type_as_the_wanted_one():
+    with pytest.raises(ValueError) as info:
+        ck.kalman_bucy(ck.models.pendulum(), T_11, None, np.zeros((11, 1)), np.eye(2), [[1.0]], np.eye(2), [0, 0])
+    assert "must be a continuous-time StateSpace: received a continuous-time NonlinearSystem" in str(info.value)
+    with pytest.raises(ValueError, match=r"received a discrete-time StateSpace \(dt=0\.1\)"):
+        ck.observer_system(_neighbours(dt=0.1)[1], L_2)

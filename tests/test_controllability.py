@@ -103,3 +103,14 @@ def test_ccf_transform_warns_when_its_result_misses_the_ccf(monkeypatch):
         ck.ccf_transform([[0, 1], [-2, -3]], [[0], [1]])
     with pytest.warns(ck.AccuracyWarning, match=r"observability canonical form \(4.31\) misses"):
         ck.ocf_transform([[0, 1], [-2, -3]], [[1, 0]])
+
+
+def test_a_nearly_singular_t_warns_and_a_well_conditioned_one_does_not():
+    # issue 25: T of condition 1e15 passed without a word
+    import warnings
+    sys = ck.StateSpace([[0.0, 1.0], [-2.0, -3.0]], [[0.0], [1.0]], [[1.0, 0.0]])
+    with pytest.warns(ck.AccuracyWarning, match=r"T is nearly singular \(condition number 3\.2e\+15\)"):
+        ck.similarity_transform(sys, [[1.0, 1.0], [1.0, 1.0 + 1e-15]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        ck.similarity_transform(sys, [[1.0, 1.0], [0.0, 1e-4]])   # condition 2e4

@@ -484,3 +484,36 @@ def test_kalman_bucy_rejects_nan_data_by_name():
     with pytest.raises(ValueError, match=r"u contains NaN or infinite entries"):
         ck.kalman_bucy(ck.StateSpace(A, B, C), t, np.full((11, 1), np.inf), np.zeros((11, 1)), Q, R,
                        np.eye(2), [0, 0])
+
+
+def test_absurd_substeps_are_refused_before_any_work():
+    # issue 25: substeps=10**9 made kalman_bucy and the EKF run for hours
+    import time
+    t = np.linspace(0.0, 1.0, 11)
+    sys = ck.StateSpace([[0.0, 1.0], [-2.0, -3.0]], [[0.0], [1.0]], [[1.0, 0.0]])
+    args = (t, None, np.zeros((11, 1)), np.eye(2), [[1.0]], np.eye(2), [0.0, 0.0])
+    start = time.perf_counter()
+    for substeps in (10**9, 1001, 1e300):
+        with pytest.raises(ValueError, match=r"substeps must be at most 1000: received .*finer grid t"):
+            ck.kalman_bucy(sys, *args, substeps=substeps)
+        with pytest.raises(ValueError, match=r"substeps must be at most 1000"):
+            ck.extended_kalman_filter(ck.models.pendulum(), *args, substeps=substeps)
+    assert time.perf_counter() - start < 2.0
+    # the limit itself is allowed, and agrees with the default to RK4's accuracy
+    np.testing.assert_allclose(ck.kalman_bucy(sys, *args, substeps=1000).x,
+                               ck.kalman_bucy(sys, *args).x, atol=1e-9)
+
+
+def test_the_no_solution_message_names_each_mode_once_and_rounding_as_zero():
+    # issue 25: with Q = 0 the double integrator's Jordan block gave the same paragraph twice,
+    # and a rotated mode at 0 was printed as lambda = -1.11e-16
+    with pytest.raises(ValueError) as info:
+        ck.kalman_gain([[0.0, 1.0], [0.0, 0.0]], [[1.0, 0.0]], np.zeros((2, 2)), [[1.0]])
+    text = str(info.value)
+    assert text.count("the mode λ = 0 of A (eigenvector [1. 0.])") == 1, text
+    assert "-0." not in text
+    rng = np.random.default_rng(3)
+    rotation, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    A = rotation @ np.diag([0.0, -1.0, -2.0]) @ rotation.T     # eig: about -1.1e-16, -1, -2
+    with pytest.raises(ValueError, match=r"the mode λ = 0 of A \(eigenvector"):
+        ck.kalman_gain(A, np.array([[1.0, 0.0, 0.0]]) @ rotation.T, np.zeros((3, 3)), [[1.0]])

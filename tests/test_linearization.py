@@ -101,7 +101,8 @@ def test_linearize_checks_tol():
             ck.linearize(lambda x, u: -x, [0.0], tol=tol)
 
 
-@given(st.integers(1, 5), st.integers(1, 3), st.integers(0, 10_000))
+@example(n=4, q=1, seed=1704)
+@given(n=st.integers(1, 5), q=st.integers(1, 3), seed=st.integers(0, 10_000))
 def test_batched_central_differences_are_the_column_by_column_ones(n, q, seed):
     # the EKF evaluates g once on the batch of _perturbed(z); _quotients must then give the
     # numbers _jacobian(refine=False) gets from 2n separate calls, and the last column is z
@@ -124,8 +125,11 @@ def test_batched_central_differences_are_the_column_by_column_ones(n, q, seed):
     G = g(Z)
     J = _quotients(G, h)
     # g on a batch may round differently from g on one state (numpy picks other loops for
-    # 2-D arrays): each value may differ by a few ulps, which the quotient divides by 2 h_k
-    ulps = 8 * np.finfo(float).eps * np.abs(G).max(axis=1, keepdims=True)
+    # 2-D arrays): each value may differ by a few ulps of its largest term (which may exceed the
+    # value itself: seed 1704 cancels), and the quotient divides that by 2 h_k
+    terms = np.array([np.abs(a[r] * Z[i[r]] * Z[j[r]]) + np.abs(Z[j[r]]) ** 3 + 2 * np.abs(Z[i[r]])
+                      for r in range(q)])
+    ulps = 8 * np.finfo(float).eps * terms.max(axis=1, keepdims=True)
     np.testing.assert_array_less(np.abs(J - _jacobian(g, z, refine=False)), ulps / h + 1e-300)
     exact = np.zeros((q, n))
     for r in range(q):
@@ -262,3 +266,98 @@ def test_noise_never_passes_silently_as_an_accurate_derivative():
             A, _ = ck.linearize(noisy, [0.3], check_equilibrium=False)
         warned = any(issubclass(w.category, ck.AccuracyWarning) for w in caught)
         assert warned or abs(A[0, 0] - exact) <= 1e-7 * exact, (salt, A[0, 0] - exact)
+
+
+# --- affine maps are linearized exactly (issue 25) ------------------------------------
+
+def test_the_affine_map_of_the_issue_is_exact():
+    # issue 25: 16.799999237 (relative error 4.5e-8), with the equilibrium's offset inside f
+    A, _ = ck.linearize(lambda x, u: np.array([(1.6 + x[0]) * 16.8 - 1.6 * 16.8]), [0.0])
+    assert abs(A[0, 0] - 16.8) <= 4 * np.finfo(float).eps * 16.8
+
+
+def test_lotka_volterra_is_exact_in_both_jacobians():
+    # predator-prey in deviations from its equilibrium, harvest u* + du of the predators: f is
+    # bilinear in x and linear in u (main 73dc894: df/du wrong in the 8th digit, 1.25e-8)
+    a, b, c, d, u_eq = 1.9, 1.0, 1.7, 0.7, 0.2
+    x_eq = np.array([(c + u_eq) / d, a / b])
+
+    def f(dx, du):
+        x, y, u = x_eq[0] + dx[0], x_eq[1] + dx[1], u_eq + du[0]
+        return np.array([a * x - b * x * y, d * x * y - c * y - u * y])
+
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        A, B = ck.linearize(f, [0.0, 0.0], [0.0], check_equilibrium=False)
+    # recomputed by hand: df/dx = [[a - b y, -b x], [d y, d x - c - u]], df/du = [0, -y]
+    A_true = np.array([[a - b * x_eq[1], -b * x_eq[0]], [d * x_eq[1], d * x_eq[0] - c - u_eq]])
+    np.testing.assert_allclose(A, A_true, rtol=0, atol=8 * np.finfo(float).eps * np.abs(A_true).max())
+    assert B[0, 0] == 0.0 and abs(B[1, 0] + x_eq[1]) <= 4 * np.finfo(float).eps * x_eq[1]
+
+
+_SCALE = st.floats(-8, 8)
+
+
+@settings(max_examples=200, deadline=None)
+@given(n=st.integers(1, 4), m=st.integers(0, 3), seed=st.integers(0, 2**32 - 1),
+       coefficients=_SCALE, x_scale=_SCALE, u_scale=_SCALE, shifted=st.booleans())
+def test_random_affine_maps_are_exact_at_every_scale(n, m, seed, coefficients, x_scale, u_scale, shifted):
+    rng = np.random.default_rng(seed)
+    # coefficients 10^-8..10^8, each column a further factor 1..100 apart, some entries zero
+    A0 = rng.normal(size=(n, n)) * 10.0 ** coefficients * 10.0 ** rng.uniform(0, 2, size=n)
+    B0 = rng.normal(size=(n, m)) * 10.0 ** coefficients * 10.0 ** rng.uniform(0, 2, size=m)
+    A0[rng.random(size=(n, n)) < 0.2] = 0.0
+    x_eq = rng.uniform(-1, 1, size=n) * 10.0 ** x_scale
+    u_eq = rng.uniform(-1, 1, size=m) * 10.0 ** u_scale
+    if shifted:  # written around the equilibrium, as a model in deviations would be
+        def f(x, u):
+            return A0 @ (x - x_eq) + B0 @ (u - u_eq)
+    else:        # written with its own offset: A x + B u + c
+        c = -(A0 @ x_eq + B0 @ u_eq)
+        def f(x, u):
+            return A0 @ x + B0 @ u + c
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")   # never an AccuracyWarning ("f not smooth") on a straight line
+        A, B = ck.linearize(f, x_eq, u_eq if m else None, check_equilibrium=False)
+    # to rounding: a few eps of each column, plus the rounding of the largest intermediate value
+    # (|A0| |x_eq| + |B0| |u_eq|, or x - x_eq) seen through the steps, about 1/8 of the point's size
+    eps, size = np.finfo(float).eps, max(1.0, np.abs(x_eq).max(), np.abs(u_eq).max(initial=0))
+    offset = float((np.abs(A0) @ np.abs(x_eq) + np.abs(B0) @ np.abs(u_eq)).max())
+    for J, J0 in ((A, A0), (B, B0)):
+        tol = 16 * eps * np.abs(J0).max(axis=0, initial=0.0) + 64 * eps * offset / size
+        assert np.all(np.abs(J - J0) <= tol[None, :]), (np.abs(J - J0).max(axis=0), tol)
+
+
+def test_a_missing_u_eq_is_named_instead_of_the_students_index_error():
+    def pend(x, u):
+        return np.array([x[1], -9.81 * np.sin(x[0]) + u[0]])
+
+    with pytest.raises(ValueError, match=r"^u_eq is missing: f \(pend\) raised IndexError(?s:.*)u_eq=\[0\.0\]"):
+        ck.linearize(pend, [0.0, 0.0])
+    with pytest.raises(ValueError, match=r"^u_eq is missing: .*find_equilibria"):
+        ck.find_equilibria(pend, n=2)
+
+
+@pytest.mark.parametrize("flag", ["no", None, 0, 1, "False"])
+def test_check_equilibrium_must_be_a_real_bool(flag):
+    with pytest.raises(ValueError, match=r"check_equilibrium must be True or False"):
+        ck.linearize(lambda x, u: -x, [1.0], check_equilibrium=flag)
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda x1, x2: ck.symbolic_jacobian([x2, -sp.sin(x1)], []), "variables is empty"),
+    (lambda x1, x2: ck.symbolic_jacobian([x2, -sp.sin(x1)], ["x1", "x2"]), "variables must be a list"),
+    (lambda x1, x2: ck.symbolic_jacobian([], [x1, x2]), "f is empty"),
+    (lambda x1, x2: ck.linearize_symbolic([x2, -sp.sin(x1)], [], x_eq=[]), "x is empty"),
+    (lambda x1, x2: ck.linearize_symbolic([x2, -sp.sin(x1)], "x1 x2", x_eq=[0, 0]), "x must be a list"),
+])
+def test_empty_or_text_symbol_lists_are_refused(call, name):
+    # issue 25: an empty list gave an empty Jacobian without a word
+    with pytest.raises(ValueError, match=rf"^{name}"):
+        call(*sp.symbols("x1 x2"))
+    # no input at all stays allowed
+    x1, x2 = sp.symbols("x1 x2")
+    A, B = ck.linearize_symbolic([x2, -sp.sin(x1)], [x1, x2], [], x_eq=[0, 0])
+    assert B.shape == (2, 0)

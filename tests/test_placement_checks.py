@@ -347,3 +347,37 @@ def test_an_overflowing_gain_is_an_error_not_a_nan():
         ck.place([[0, 1], [0, 0]], [[0], [1]], [-1e200, -1e200])
     with pytest.raises(ValueError, match=r"the gain L overflows double precision.*obsv_singular"):
         ck.place_observer([[0, 1], [0, 0]], [[1, 0]], [-1e200, -1e200])
+
+
+def test_several_inputs_above_a_hundred_states_are_refused_before_any_work():
+    # issue 25: a 200-state, 3-input place ran for minutes (Tits-Yang's iteration, then Heymann)
+    import time
+    rng = np.random.default_rng(0)
+    A = rng.standard_normal((200, 200))
+    start = time.perf_counter()
+    with pytest.raises(ValueError, match=r"A has 200 states: pole placement with several channels "
+                                         r"\(B has 3 columns\) is limited to 100 states"):
+        ck.place(A, rng.standard_normal((200, 3)), -np.linspace(1, 20, 200))
+    with pytest.raises(ValueError, match=r"\(C has 3 rows\) is limited to 100 states(?s:.*)kalman_gain"):
+        ck.place_observer(A, rng.standard_normal((3, 200)), -np.linspace(1, 20, 200))
+    assert time.perf_counter() - start < 1.0
+    # one input is cheap (one Hessenberg reduction) and stays allowed
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", ck.AccuracyWarning)
+        assert ck.place(A, rng.standard_normal((200, 1)), -np.linspace(1, 20, 200)).shape == (1, 200)
+
+
+def test_poles_far_below_the_scale_of_a_warn():
+    # issue 25: for A scaled by 1e200 the closed loop's poles came out near 4e193, not at -1 and
+    # -2, and the check passed them, measuring the error against A's own size
+    A = np.array([[0.0, 1.0], [-2.0, -3.0]]) * 1e200
+    with pytest.warns(ck.AccuracyWarning, match=r"largest error is 3\.9\d*e\+193 at the requested pole"):
+        ck.place(A, [[0.0], [1.0]], [-1.0, -2.0])
+    with pytest.warns(ck.AccuracyWarning, match=r"estimation error|requested pole"):
+        ck.place_observer(A, [[1.0, 0.0]], [-1.0, -2.0])
+    # the same request at a scale double precision can hold is met without a warning
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        K = ck.place(np.array([[0.0, 1.0], [-2.0, -3.0]]) * 1e6, [[0.0], [1.0]], [-1.0, -2.0])
+    # det(sI - A - B K) = s^2 - (A22 + k2) s - A12 (A21 + k1) = s^2 + 3 s + 2
+    np.testing.assert_allclose(K, [[2e6 - 2e-6, 3e6 - 3.0]], rtol=1e-14)

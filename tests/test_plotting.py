@@ -107,3 +107,10 @@ def test_plotting_does_not_import_matplotlib_at_package_import():
     code = "import sys, coursekit; print('matplotlib' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+@pytest.mark.parametrize("ax", ["ax", 3, np.zeros(2)])
+def test_plot_state_plane_refuses_what_is_not_an_axes(ax):
+    # issue 25: AttributeError: 'str' object has no attribute 'figure'
+    with pytest.raises(ValueError, match=r"^ax must be a matplotlib Axes: received"):
+        ck.plot_state_plane([np.zeros((3, 2))], ax=ax)

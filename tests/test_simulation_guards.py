@@ -28,6 +28,10 @@ ISOLATED = {
     "f NaN later (x reaches 1 near t = 0.6)": (
         "ck.simulate(ck.NonlinearSystem(lambda x, u: np.sqrt(1 - x) + 1, n=1), np.linspace(0, 1, 11), x0=[0.0])",
         "UserFunctionError", r"f returned NaN or inf at t = 0\.\d+, x = \[1\.0"),
+    "stiff Van der Pol, mu = 1e4, explicit method (issue 25: hung)": (
+        "ck.simulate(ck.NonlinearSystem(lambda x, u: np.array([x[1], 1e4 * (1 - x[0] ** 2) * x[1] - x[0]]), n=2), "
+        "np.linspace(0, 100, 11), x0=[2.0, 0.0], method='DOP853')",
+        "SimulationError", r"method='DOP853' cannot finish in bounded work: .*\|lambda\| = 3e\+04(?s:.*)method='Radau'"),
     "f NaN later, Radau": (
         "ck.simulate(ck.NonlinearSystem(lambda x, u: np.sqrt(1 - x) + 1, n=1), np.linspace(0, 1, 11), "
         "x0=[0.0], method='Radau')",
@@ -281,3 +285,22 @@ def test_a_large_but_finite_state_is_returned():
     # e^300 ~ 2e130 is far from the float limit: no error, the exact value
     res = ck.simulate(ck.StateSpace([[1.0]]), np.linspace(0, 300, 31), x0=[1.0])
     np.testing.assert_allclose(res.x[-1, 0], np.exp(300.0), rtol=1e-12)   # a few ulps per step, 30 steps
+
+
+def test_stiffness_that_appears_later_stops_at_the_evaluation_bound(monkeypatch):
+    # Van der Pol from x0 = [1, 0]: the Jacobian there has rate 1, so the run starts, and the
+    # stiffness (rate ~ 3e4) comes later; the bound on evaluations stops it (lowered here to
+    # keep the test fast; it is 1e6, about six seconds of a cheap f)
+    import coursekit.simulation as simulation
+    monkeypatch.setattr(simulation, "_MAX_EVALUATIONS", 20_000)
+    vdp = ck.NonlinearSystem(lambda x, u: np.array([x[1], 1e4 * (1 - x[0] ** 2) * x[1] - x[0]]), n=2)
+    for run in (lambda: ck.simulate(vdp, np.linspace(0, 100, 11), x0=[1.0, 0.0]),
+                lambda: ck.simulate_batch(vdp, np.linspace(0, 100, 11), [[1.0, 0.0], [1.0, 0.1]])):
+        with pytest.raises(ck.SimulationError, match=r"evaluated f 20,000 times and reached only t = "
+                                                     r"[\d.]+ of 100(?s:.*)method='Radau'"):
+            run()
+    # from x0 = [2, 0] the stiffness shows at the start: refused before any step, in a batch too
+    with pytest.raises(ck.SimulationError, match=r"cannot finish in bounded work"):
+        ck.simulate_batch(vdp, np.linspace(0, 100, 11), [[2.0, 0.0], [2.0, 0.1]])
+    # the implicit methods are not stopped: Radau solves it in a few hundred steps
+    assert ck.simulate(vdp, np.linspace(0, 100, 11), x0=[1.0, 0.0], method="Radau").x.shape == (11, 2)

@@ -93,3 +93,41 @@ def test_symbolic_bad_input():
         ck.symbolic_ctrb([[1, 0], [0, 1]], [[1], [0], [0]])
     with pytest.raises(ValueError, match=r"not controllable: det Wc = 0"):
         ck.symbolic_linear_flatness([[-3, 0], [1, -2]], [[0], [1]])
+
+
+@pytest.mark.parametrize("call", [
+    lambda: ck.symbolic_ctrb(np.array(1.0), [[1.0]]),
+    lambda: ck.symbolic_ctrb(np.zeros((2, 2, 2)), [[1.0], [0.0]]),
+    lambda: ck.symbolic_ctrb([[0.0, 1.0], [0.0, 0.0]], np.zeros((2, 1, 1))),
+    lambda: ck.symbolic_linear_flatness(np.float64(1.0), [[1.0]]),
+    lambda: ck.symbolic_linear_flatness(np.zeros((2, 2, 2)), [[1.0], [0.0]]),
+])
+def test_arrays_that_are_not_matrices_are_named(call):
+    # issue 25: sympy's NotImplementedError "SymPy supports just 1D and 2D matrices"
+    with pytest.raises(ValueError, match=r"^[AB] must be a matrix .* with [03] dimensions"):
+        call()
+
+
+@pytest.mark.parametrize("values, message", [
+    ([0.0], r"values has the wrong number of rows: received shape \(1, 1\), expected 3 rows"),
+    ({"a": 1}, r"values must contain real numbers"),
+    (None, r"values is missing"),
+    ([np.nan, 0.0, 0.0], r"values contains NaN"),
+])
+def test_flat_map_functions_name_wrong_values(values, message):
+    # issue 25: IndexError / KeyError / TypeError from inside the lambdified maps
+    fx, fu = ck.symbolic_flat_maps("pendulum", m=1.0, l=1.0, g=9.81, d_theta=0.0).functions()
+    for func in (fx, fu):
+        with pytest.raises(ValueError, match=message):
+            func(values)
+    gx, _ = ck.symbolic_flat_maps("two_wheeled").functions()
+    with pytest.raises(ValueError, match=r"values has the wrong number of columns: received shape \(3, 1\), "
+                                         r"expected 2 columns \(one per flat output\)"):
+        gx([[0.0], [0.0], [0.0]])
+
+
+def test_flat_map_functions_with_symbolic_parameters_say_which():
+    fx, fu = ck.symbolic_flat_maps("pendulum").functions()
+    np.testing.assert_array_equal(fx([0.1, 0.2, 0.3]), [0.1, 0.2])     # psi_x has no parameter
+    with pytest.raises(ValueError, match=r"psi_u still contains the parameters d_theta, g, l, m"):
+        fu([0.1, 0.2, 0.3])

@@ -415,3 +415,10 @@ def test_open_loop_plan_follows_changes_of_units(time_unit, state_units):
     np.testing.assert_allclose(plan.x(t / a) / D, reference.x(t), rtol=0, atol=1e-9)
     np.testing.assert_allclose(plan.ud(t / a), reference.ud(t), rtol=0,
                                atol=1e-9 * np.abs(reference.ud(t)).max())
+
+
+def test_plot_plan_refuses_a_time_grid_that_does_not_increase():
+    # issue 25: a decreasing grid was plotted as if it were one
+    t = np.linspace(0.0, 1.0, 11)
+    with pytest.raises(ValueError, match=r"^t must be strictly increasing"):
+        ck.plot_plan(t[::-1], np.zeros((11, 2)), np.zeros((11, 1)), title="plan")
