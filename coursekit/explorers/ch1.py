@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from .. import models
-from .._validation import as_integer, as_scalar, time_grid
+from .._validation import MAX_SAMPLES, as_scalar, time_grid
 from ..realization import euler_discretize
 from ..simulation import simulate
 from ..systems import StateSpace
@@ -46,11 +46,13 @@ def euler_compute(Ts: float, example: str = "first order (1.12)", samples: int =
     ``stable`` (rho < 1), the stability limit ``Ts_max`` and the ``unit``.
     """
     Ts = as_scalar(Ts, "Ts", positive=True)
-    samples = as_integer(samples, "samples", minimum=2, why="a curve needs two points at least")
     if not isinstance(example, str) or example not in EULER_EXAMPLES:
         raise ValueError(f"example must be one of {list(EULER_EXAMPLES)}: received {example!r}.")
     sys, x0, t_end, unit = EULER_EXAMPLES[example]
-    t = np.linspace(0.0, t_end, samples)
+    t = time_grid(t_end, samples)
+    if t_end / Ts > MAX_SAMPLES:
+        raise ValueError(f"Ts is too small: {t_end / Ts:.3g} Euler steps over {t_end:g} s; take Ts >= "
+                         f"{t_end / MAX_SAMPLES:.2g} s.")
     exact = simulate(sys, t, x0=x0)
     disc = euler_discretize(sys, Ts)
     tk = np.arange(int(np.floor(t_end / Ts + 1e-9)) + 1) * Ts
@@ -120,6 +122,9 @@ def msd_compute(m: float, d: float, k: float, experiment: str = "step", t_end: f
     m = as_scalar(m, "m", positive=True)
     k = as_scalar(k, "k", positive=True)
     d = as_scalar(d, "d")
+    if not np.all(np.isfinite([k / m, d / m])):
+        raise ValueError(f"m, d, k give a system beyond the float range (k/m = {k / m:g}, d/m = {d / m:g}): "
+                         "pass a mass that is not negligible against the spring and the damper.")
     if not isinstance(experiment, str) or experiment not in ("step", "initial"):
         raise ValueError(f"experiment must be 'step' or 'initial': received {experiment!r}.")
     sys = models.mass_spring_damper(m=m, d=d, k=k)

@@ -68,6 +68,10 @@ def pole_placement_compute(wn: float = 2.0, zeta: float = 0.7, p3: float = -3.0,
     p3 = as_scalar(p3, "p3")
     t = time_grid(t_end, samples)
     poles = np.concatenate([pair_poles(wn, zeta), [p3]])
+    if np.abs(poles).max() * t[-1] > 1e6:
+        raise ValueError(f"wn, zeta and p3 ask for poles up to {np.abs(poles).max():.3g} 1/s: over t_end = "
+                         f"{t[-1]:g} s the response would change by e^{np.abs(poles).max() * t[-1]:.3g}; "
+                         "pick poles a few times faster than the plant's, within the sliders' range.")
     K = place(PLACEMENT_A, PLACEMENT_B, poles)
     A_cl = PLACEMENT_A + PLACEMENT_B @ K
     x = simulate(StateSpace(A_cl), t, x0=[1.0, 0.0, 0.0]).x

@@ -161,8 +161,7 @@ def kalman_tuning_compute(log10_q: float, log10_r: float, *, seed: int = 0, t_en
     per state over the second half), ``rms_matched`` (the same for the
     matched filter) and ``L_matched``.
     """
-    q = 10.0 ** as_scalar(log10_q, "log10_q")
-    r = 10.0 ** as_scalar(log10_r, "log10_r")
+    q, r = (10.0 ** _exponent(value, name) for value, name in ((log10_q, "log10_q"), (log10_r, "log10_r")))
     # validated before the cache, so that the cache key is the checked value
     t_end = float(time_grid(t_end, samples)[-1])
     seed, samples = as_integer(seed, "seed", minimum=0), as_integer(samples, "samples")
@@ -170,6 +169,15 @@ def kalman_tuning_compute(log10_q: float, log10_r: float, *, seed: int = 0, t_en
     L, x_hat, rms = _kalman_run(sys, t, record, data.x, np.diag([0.0, q]), [[r]])
     return dict(t=t.copy(), x=data.x.copy(), x_hat=x_hat, y=data.y[:, 0].copy(), L=L, q=q, r=r,
                 poles=np.linalg.eigvals(sys.A - L @ sys.C), rms=rms, rms_matched=rms_m, L_matched=L_m)
+
+
+def _exponent(value, name: str) -> float:
+    """A base-10 exponent of a noise intensity, checked to give a finite, nonzero intensity."""
+    value = as_scalar(value, name)
+    if abs(value) > 100:
+        raise ValueError(f"{name} must lie in [-100, 100]: received {value:g}, an intensity of 10^{value:g}; "
+                         "the slider's range is a few decades around the true intensity.")
+    return value
 
 
 def _log_slider(true_value: float, low: float, high: float, description: str, step: float = 0.1):
