@@ -26,6 +26,8 @@ import numbers
 import os
 from typing import Any
 
+import numpy as np
+
 __all__ = ["ANSWERS_ENV", "MAX_ITEMS", "Tape", "Replay", "encode", "decode", "append_record",
            "read_records"]
 
@@ -56,8 +58,8 @@ def _is_sympy(value) -> bool:
 
 
 def _number(value) -> Any:
-    """A Python or NumPy number as JSON (complex numbers as {"complex": [re, im]})."""
-    if isinstance(value, bool) or type(value).__name__ == "bool_":
+    """A Python number as JSON (complex numbers as {"complex": [re, im]})."""
+    if isinstance(value, bool):
         return bool(value)
     if isinstance(value, numbers.Integral):
         return int(value)
@@ -93,14 +95,14 @@ def _encode_sympy(value, budget: _Budget) -> Any:
 def _encode(value, budget: _Budget) -> Any:
     if value is None or isinstance(value, str):
         return value if value is None or budget.take(len(value) // 100 + 1) else {"opaque": "str"}
+    if isinstance(value, np.generic) and value.dtype.kind in "biufc":
+        return _number(value.item())                   # np.False_, np.int64(2), ... as numbers
     if isinstance(value, numbers.Number) and not _is_sympy(value):
         return _number(value)
     if _is_sympy(value):
         return _encode_sympy(value, budget)
-    if type(value).__name__ == "ndarray" or (hasattr(value, "dtype") and hasattr(value, "ravel")
-                                             and hasattr(value, "shape")):
-        import numpy as np
-        return _encode_array(np.asarray(value), budget)
+    if isinstance(value, np.ndarray):
+        return _encode_array(value, budget)
     if isinstance(value, (list, tuple)) and budget.take(len(value)):
         items = [_encode(v, budget) for v in value]
         return items if isinstance(value, list) else {"tuple": items}
@@ -171,14 +173,12 @@ def _opaque(name) -> object:
 
 
 def _decode_array(data: dict):
-    import numpy as np
     kind = {"b": bool, "i": int, "u": int, "f": float, "c": complex}.get(data.get("kind"), float)
     flat = [decode(v) for v in data.get("ndarray", [])]
     return np.array(flat, dtype=kind).reshape([int(n) for n in data.get("shape", [len(flat)])])
 
 
 def _decode_objects(data: dict):
-    import numpy as np
     flat = [decode(v) for v in data.get("objects", [])]
     out = np.empty(len(flat), dtype=object)
     out[:] = flat
