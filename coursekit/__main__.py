@@ -134,7 +134,7 @@ _NOT_A_SANDBOX = (
     "can. For untrusted notebooks, or many of them, run the grader in a container with only the "
     "submissions and the output folder mounted, e.g. docker run --rm --network none -v "
     "\"$PWD/submissions:/submissions:ro\" -v \"$PWD/grades:/grades\" IMAGE python -m coursekit grade "
-    "--chapter 1 /submissions --out /grades (IMAGE: any image with coursekit[site] installed; "
+    "--chapter 1 /submissions --out /grades (IMAGE: any image with coursekit[grade] installed; "
     "podman takes the same arguments). See docs/grading.md.")
 
 
@@ -148,6 +148,7 @@ def _add_grade(commands) -> None:
                     "the notebook (a check replaced or patched in the notebook awards nothing). Writes "
                     "DIR/grades.csv (one row per student: 1 or 0 per exercise, total, status) and "
                     "DIR/feedback/STUDENT.md (what each check says about the answer, never the solution). "
+                    "Needs the grade extra: python -m pip install -e \".[grade]\". "
                     "Statuses: " + "; ".join(f"{k}: {v}" for k, v in _statuses().items()) + ". "
                     + _NOT_A_SANDBOX)
     parser.add_argument("submissions", type=Path, metavar="SUBMISSIONS",
