@@ -29,14 +29,18 @@ def kernel_argv(memory_bytes: int, cpu_seconds: int) -> list[str]:
             "-f", "{connection_file}", "--HistoryManager.hist_file=:memory:"]
 
 
-def set_limits(memory_bytes: int, cpu_seconds: int) -> None:
-    """Limit this process's address space and CPU time (soft = hard); nothing without `resource`."""
+def set_limits(memory_bytes: int, cpu_seconds: int | None = None) -> None:
+    """Limit this process's address space and CPU time (soft = hard; no CPU limit for None).
+
+    Does nothing where the `resource` module does not exist (Windows).
+    """
     try:
         import resource
     except ImportError:
         return
     resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
-    resource.setrlimit(resource.RLIMIT_CPU, (cpu_seconds, cpu_seconds))
+    if cpu_seconds is not None:
+        resource.setrlimit(resource.RLIMIT_CPU, (cpu_seconds, cpu_seconds))
 
 
 def main(argv: list[str]) -> None:

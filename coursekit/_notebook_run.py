@@ -24,12 +24,16 @@ import sys
 import time
 from pathlib import Path
 
-from ._limited_kernel import kernel_argv
+from ._limited_kernel import kernel_argv, set_limits
 
-__all__ = ["KERNEL_NAME", "write_kernel_spec", "execute", "main"]
+__all__ = ["KERNEL_NAME", "RUNNER_MEMORY", "write_kernel_spec", "execute", "main"]
 
 #: name of the kernel spec the grader writes for its kernels
 KERNEL_NAME = "coursekit-grade"
+
+#: address space this runner may use beyond its kernel's limit (a notebook that prints without
+#: end fills the runner's copy of the outputs: the runner then fails, not the machine)
+RUNNER_MEMORY = 2 * 2**30
 
 
 def write_kernel_spec(kernels_dir: Path, memory_bytes: int, cpu_seconds: int) -> Path:
@@ -101,6 +105,7 @@ def execute(notebook: Path, kernels_dir: Path, timeout: float, memory_bytes: int
 def main(argv: list[str]) -> int:
     """Command-line entry: print the outcome of running the notebook as the last line."""
     notebook, kernels_dir, timeout, memory_bytes = Path(argv[0]), Path(argv[1]), float(argv[2]), int(argv[3])
+    set_limits(memory_bytes + RUNNER_MEMORY)
     outcome = execute(notebook, kernels_dir, timeout, memory_bytes)
     sys.stdout.write("\n" + json.dumps(outcome) + "\n")
     sys.stdout.flush()

@@ -31,6 +31,7 @@ import csv
 import io
 import json
 import os
+import re
 import signal
 import subprocess
 import sys
@@ -50,7 +51,7 @@ STATUSES = {
     "timeout": "the notebook was stopped at the time limit; the answers given before count",
     "crashed": "the kernel died (os._exit, a crash, the memory limit); the answers given before count",
     "invalid notebook": "the file is not a readable notebook (not nbformat JSON); not run",
-    "wrong chapter": "the notebook is another chapter's; not run",
+    "wrong chapter": "the notebook is another chapter's (its title or the checks it calls); not run",
     "grader error": "the grader could not run this notebook; not graded",
 }
 
@@ -85,14 +86,18 @@ def parse_memory(text: str) -> int:
 
 
 def _chapter_of(nb) -> int | None:
-    """The chapter a notebook says it is ("# Chapter 2 ..." in a markdown cell), or None."""
-    import re
+    """The chapter a notebook is: its title ("# Chapter 2 ..."), else the one chapter whose
+    checks its code calls; None when neither tells."""
+    from .exercises._catalog import CATALOG
     for cell in nb.cells:
         if cell.cell_type == "markdown":
             match = re.search(r"^#\s+Chapter\s+(\d+)", cell.source, re.M)
             if match:
                 return int(match[1])
-    return None
+    code = "\n".join(cell.source for cell in nb.cells if cell.cell_type == "code")
+    called = {number for number, entries in CATALOG.items() for entry in entries
+              if re.search(rf"\b{entry.check}\s*\(", code)}
+    return called.pop() if len(called) == 1 else None
 
 
 def _read_submission(path: Path, chapter: int):
@@ -105,7 +110,7 @@ def _read_submission(path: Path, chapter: int):
         return ("invalid notebook", f"{type(error).__name__}: {str(error).splitlines()[0][:200]}")
     said = _chapter_of(nb)
     if said is not None and said != chapter:
-        return ("wrong chapter", f"the notebook is chapter {said}, this grading is chapter {chapter}")
+        return ("wrong chapter", f"the notebook is chapter {said}, the grading is for chapter {chapter}")
     return nb
 
 

@@ -8,7 +8,7 @@ of a folder of chapter-1 submissions:
 * ``patched``: the checks replaced by ``lambda *a: True``: 0, "not answered";
 * ``tampered``: the feedback helpers patched so that the real checks praise
   wrong answers: 0 (the answers are checked again by the grader);
-* ``loop``, ``exit``, ``memory``, ``invalid``, ``chapter2``, ``files``: an
+* ``loop``, ``exit``, ``memory``, ``invalid``, ``chapter2``, ``untitled3``, ``files``: an
   endless loop, ``os._exit(3)``, a 50 GiB allocation, invalid JSON, another
   chapter's notebook and cells that write and delete files around them: each
   gets its status, and the answers given before (and after) the accident count.
@@ -80,6 +80,7 @@ def _submissions(folder: Path) -> None:
         "memory": [heading, *setup, *_answer(solved, CHECKS[3]),
                    new_code_cell("big = np.ones(50 * 2**30, dtype=np.uint8)"), *_answer(solved, CHECKS[4])],
         "chapter2": [new_markdown_cell("# Chapter 2 — Controllability"), *setup],
+        "untitled3": [*setup, new_code_cell("ex.check_stability([True, True, True, True])")],
         "files": [heading, *setup, *_answer(solved, CHECKS[2]), new_code_cell(
             "import os, shutil\nos.remove(os.environ['COURSEKIT_ANSWERS_FILE'])\n"
             "open('../stray.txt', 'w').write('x')\nfor entry in os.listdir('.'):\n    os.remove(entry)\n"
@@ -119,7 +120,8 @@ def test_grades_csv_has_one_sorted_row_per_notebook_and_the_columns_of_the_chapt
     assert lines[0].split(",") == ["student", *CHECKS, "total", "status"]
     students = [line.split(",")[0] for line in lines[1:]]
     assert students == sorted(students) == sorted(
-        ["solutions", "student", "patched", "tampered", "loop", "exit", "memory", "chapter2", "files", "invalid"])
+        ["solutions", "student", "patched", "tampered", "loop", "exit", "memory", "chapter2", "untitled3",
+         "files", "invalid"])
     assert sorted(p.stem for p in (out / "feedback").glob("*.md")) == students
 
 
@@ -147,6 +149,7 @@ def test_checks_patched_in_the_notebook_award_nothing(graded):
     ("memory", "memory", [0, 0, 0, 1, 1]),       # the cell fails, the notebook goes on
     ("invalid", "invalid notebook", [0] * 5),
     ("chapter2", "wrong chapter", [0] * 5),
+    ("untitled3", "wrong chapter", [0] * 5),       # no title, but it calls chapter 3's checks
     ("files", "ok", [0, 0, 1, 0, 0]),            # its answers file deleted, its folder removed
 ])
 def test_each_accident_gets_its_status_and_keeps_the_answers_given(graded, student, status, scores):
@@ -176,7 +179,7 @@ def test_the_submissions_folder_is_left_as_it_was(graded):
     folder = graded[0]
     assert sorted(p.name for p in folder.iterdir()) == sorted(
         [f"{name}.ipynb" for name in ("solutions", "student", "patched", "tampered", "loop", "exit", "memory",
-                                      "chapter2", "files", "invalid")] + ["notes.txt"])
+                                      "chapter2", "untitled3", "files", "invalid")] + ["notes.txt"])
 
 
 def test_bad_arguments_name_the_argument(tmp_path):
