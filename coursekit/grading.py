@@ -136,7 +136,8 @@ def _stop(process: subprocess.Popen) -> None:
 def _run_notebook(nb, student: str, timeout: float, memory: int) -> tuple[str, str, list[dict]]:
     """Execute a copy of `nb` in a folder of its own; (status, detail, answers recorded)."""
     from .exercises._answers import read_records
-    with tempfile.TemporaryDirectory(prefix="coursekit-grade-") as box:
+    # a notebook may leave files it made unremovable: that must not cost it its grades
+    with tempfile.TemporaryDirectory(prefix="coursekit-grade-", ignore_cleanup_errors=True) as box:
         work, private = Path(box) / "work" / "submission", Path(box) / "private"
         work.mkdir(parents=True)
         private.mkdir()
@@ -144,9 +145,9 @@ def _run_notebook(nb, student: str, timeout: float, memory: int) -> tuple[str, s
         notebook.write_text(json.dumps(nb), encoding="utf-8")
         answers = private / "answers.jsonl"
         answers.touch()
-        with open(answers, encoding="utf-8") as held:  # still readable if the notebook deletes it
+        with open(answers, encoding="utf-8", errors="replace") as held:  # still readable if the notebook deletes it
             status, detail = _execute(notebook, private, timeout, memory, _runner_env(answers))
-            records = read_records(f"/dev/fd/{held.fileno()}" if Path("/dev/fd").is_dir() else answers)
+            records = read_records(held)
     return status, detail, records
 
 

@@ -240,12 +240,19 @@ def append_record(check: str, arguments: dict) -> None:
         file.flush()
 
 
-def read_records(path) -> list[dict]:
-    """The well-formed records of an answers file, in order (unreadable lines are skipped)."""
+def read_records(source) -> list[dict]:
+    """The well-formed records of an answers file, in order (unreadable lines are skipped).
+
+    `source` is a path, or a file opened for reading (the grader keeps the file
+    open while the notebook runs, so it still reads it if the notebook deletes it).
+    """
     try:
-        with open(path, encoding="utf-8", errors="replace") as file:
-            text = file.read(MAX_BYTES)
-    except OSError:
+        if hasattr(source, "read"):
+            text = source.read(MAX_BYTES)
+        else:
+            with open(source, encoding="utf-8", errors="replace") as file:
+                text = file.read(MAX_BYTES)
+    except (OSError, ValueError):
         return []
     records = []
     for line in text.splitlines()[:MAX_RECORDS]:
