@@ -20,6 +20,7 @@ import argparse
 import importlib
 import inspect
 import itertools
+import os
 import statistics
 import subprocess
 import sys
@@ -309,7 +310,9 @@ def bench_grading(repeat: int, count: int = 6) -> list[str]:
                            "grade one": lambda: grade(one, tmp / "g", chapter=1, jobs=1),
                            "nbconvert": lambda: _nbconvert(one / "s01.ipynb", tmp / "nbconvert")}, repeat)
     per_minute = {jobs: 60 * count / med[jobs] for jobs in ("jobs 1", "jobs 2")}
+    load = os.getloadavg()[1] if hasattr(os, "getloadavg") else float("nan")
     return ["| measure | value | target |", "|---|---|---|",
+            f"| machine load average (5 min) at the end, {os.cpu_count()} cores | {load:.1f} | |",
             f"| notebooks graded per minute, --jobs 1 ({count} notebooks) | {per_minute['jobs 1']:.1f} | |",
             f"| notebooks graded per minute, --jobs 2 | {per_minute['jobs 2']:.1f} | |",
             f"| speed-up --jobs 2 / --jobs 1 | {per_minute['jobs 2'] / per_minute['jobs 1']:.2f} | >= 1.6 |",

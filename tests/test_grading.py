@@ -4,7 +4,7 @@ One grading run (two notebooks at a time, short time limit, small memory limit)
 of a folder of chapter-1 submissions:
 
 * ``solutions``: the instructor solutions turned into code cells: all correct;
-* ``student``: the untouched student edition (exercise section): 0;
+* ``student``: the untouched student edition (the whole notebook): 0;
 * ``patched``: the checks replaced by ``lambda *a: True``: 0, "not answered";
 * ``tampered``: the feedback helpers patched so that the real checks praise
   wrong answers: 0 (the answers are checked again by the grader);
@@ -13,8 +13,8 @@ of a folder of chapter-1 submissions:
   chapter's notebook and cells that write and delete files around them: each
   gets its status, and the answers given before (and after) the accident count.
 
-The exercise section only (not the whole chapter) keeps the run short; the
-notebooks' other cells run in their own tests.
+The other notebooks hold the exercise section only (not the whole chapter),
+which keeps the run short; the chapter's other cells run in their own tests.
 """
 
 from __future__ import annotations
@@ -61,7 +61,8 @@ def _answer(cells, check: str) -> list:
 
 def _submissions(folder: Path) -> None:
     instructor = read_notebook(default_notebook_dir() / "01_representations.ipynb")
-    student = _exercise_section(student_edition(instructor))
+    edition = student_edition(instructor)
+    student = _exercise_section(edition)
     solved = _solved(instructor)
     heading, setup = solved[0], [new_code_cell("import numpy as np\nimport coursekit.exercises as ex")]
     patch = new_code_cell("for name in dir(ex):\n    if name.startswith('check_'):\n"
@@ -71,7 +72,7 @@ def _submissions(folder: Path) -> None:
                            "assert ex.check_euler_discretization([[1, 0], [0, 1]], [[0], [0]])")
     notebooks = {
         "solutions": solved,
-        "student": student,
+        "student": edition.cells,                       # the whole edition, untouched
         "patched": [heading, *setup, patch, *student[2:]],
         "tampered": [heading, *setup, tamper],
         "loop": [heading, *setup, *_answer(solved, CHECKS[0]), new_code_cell("while True:\n    pass"),
