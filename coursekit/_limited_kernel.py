@@ -12,7 +12,8 @@ the notebook cannot raise them again) and then replaces itself with the usual
   interrupts) is ended by the system after that much CPU time.
 
 `kernel_argv` is the command a kernel spec gives for it. Where the `resource`
-module does not exist (Windows) the kernel starts without limits.
+module does not exist (Windows), or the system refuses a limit, the kernel starts
+without it.
 """
 
 from __future__ import annotations
@@ -32,15 +33,21 @@ def kernel_argv(memory_bytes: int, cpu_seconds: int) -> list[str]:
 def set_limits(memory_bytes: int, cpu_seconds: int | None = None) -> None:
     """Limit this process's address space and CPU time (soft = hard; no CPU limit for None).
 
-    Does nothing where the `resource` module does not exist (Windows).
+    A limit the system does not support (no `resource` module on Windows, an
+    address-space limit macOS refuses) is left unset rather than stopping the kernel.
     """
     try:
         import resource
     except ImportError:
         return
-    resource.setrlimit(resource.RLIMIT_AS, (memory_bytes, memory_bytes))
+    limits = [(resource.RLIMIT_AS, memory_bytes)]
     if cpu_seconds is not None:
-        resource.setrlimit(resource.RLIMIT_CPU, (cpu_seconds, cpu_seconds))
+        limits.append((resource.RLIMIT_CPU, cpu_seconds))
+    for kind, value in limits:
+        try:
+            resource.setrlimit(kind, (value, value))
+        except (ValueError, OSError):
+            pass
 
 
 def main(argv: list[str]) -> None:

@@ -246,6 +246,15 @@ def _write(outcomes: list[Outcome], chapter: int, out: Path) -> Path:
     return table
 
 
+def _require_tools() -> None:
+    """RuntimeError naming the extra to install when nbformat, nbclient or ipykernel is missing."""
+    import importlib.util
+    missing = [name for name in ("nbformat", "nbclient", "ipykernel") if importlib.util.find_spec(name) is None]
+    if missing:
+        raise RuntimeError(f"grading needs {', '.join(missing)}: install the grade extra, "
+                           "python -m pip install \"coursekit[grade]\" (or -e \".[grade]\" in the repository)")
+
+
 def _check_arguments(submissions: Path, out: Path, chapter, timeout, jobs) -> None:
     from .exercises._catalog import chapter_exercises
     chapter_exercises(chapter)
@@ -270,6 +279,7 @@ def grade(submissions, out, *, chapter: int, timeout: float = 300, memory: int |
     submissions, out = Path(submissions), Path(out)
     jobs = (os.cpu_count() or 1) if jobs is None else jobs
     _check_arguments(submissions, out, chapter, timeout, jobs)
+    _require_tools()
     memory = parse_memory(memory) if isinstance(memory, str) else int(memory)
     paths = sorted(submissions.glob("*.ipynb"), key=lambda p: p.stem)
     with ThreadPoolExecutor(max_workers=jobs) as pool:

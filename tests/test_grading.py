@@ -216,3 +216,11 @@ def test_recorded_answers_are_data_only():
     forged = json.loads('{"opaque": "os.system(\'echo hi\')", "sympy_symbol": "__import__(\'os\')"}')
     value = decode(forged)
     assert type(value).__name__ == "Symbol" and str(value) == "__import__('os')"
+
+
+def test_missing_tools_name_the_extra_to_install(tmp_path, monkeypatch):
+    import importlib.util
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "nbclient" else real(name, *a))
+    with pytest.raises(RuntimeError, match=r"nbclient.*coursekit\[grade\]"):
+        grade(tmp_path, tmp_path / "out", chapter=1)
