@@ -55,9 +55,10 @@ def _cell_errors(nb) -> list[tuple[int, str]]:
 
 def _outcome_of_errors(nb) -> dict:
     errors = _cell_errors(nb)
-    if any(name == "MemoryError" for _, name in errors):
-        cells = [i for i, name in errors if name == "MemoryError"]
-        return {"status": "memory", "detail": f"cell {cells[0]} ran out of memory (MemoryError)"}
+    cells = [str(i) for i, name in errors if name == "MemoryError"]
+    if cells:
+        which = f"cell {cells[0]}" if len(cells) == 1 else f"cells {', '.join(cells)}"
+        return {"status": "memory", "detail": f"{which} ran out of memory (MemoryError)"}
     if errors:
         listed = ", ".join(f"cell {i} ({name})" for i, name in errors)
         return {"status": "cell error", "detail": f"cells raised an exception: {listed}"}

@@ -79,7 +79,9 @@ def _submissions(folder: Path) -> None:
                  *_answer(solved, CHECKS[1])],
         "exit": [heading, *setup, *_answer(solved, CHECKS[1]), new_code_cell("import os\nos._exit(3)")],
         "memory": [heading, *setup, *_answer(solved, CHECKS[3]),
-                   new_code_cell("big = np.ones(50 * 2**30, dtype=np.uint8)"), *_answer(solved, CHECKS[4])],
+                   new_code_cell("big = np.ones(50 * 2**30, dtype=np.uint8)"),
+                   # 3 GiB of address space, never touched: refused only under the 2G limit
+                   new_code_cell("reserved = np.empty(3 * 2**30, dtype=np.uint8)"), *_answer(solved, CHECKS[4])],
         "chapter2": [new_markdown_cell("# Chapter 2 — Controllability"), *setup],
         "untitled3": [*setup, new_code_cell("ex.check_stability([True, True, True, True])")],
         "files": [heading, *setup, *_answer(solved, CHECKS[2]), new_code_cell(
@@ -157,6 +159,11 @@ def test_each_accident_gets_its_status_and_keeps_the_answers_given(graded, stude
     row = _rows(graded[1])[student]
     assert (row["status"], _scores(row)) == (status, scores)
     assert int(row["total"]) == sum(scores)
+
+
+def test_the_memory_limit_applies_to_the_kernel(graded):
+    feedback = (graded[1] / "feedback" / "memory.md").read_text(encoding="utf-8")
+    assert "cells 3, 4 ran out of memory (MemoryError)" in feedback
 
 
 def test_feedback_is_what_the_checks_say_never_the_solution(graded):
