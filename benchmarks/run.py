@@ -6,6 +6,8 @@ Run from the repository root (with the `dev` extra installed):
     python benchmarks/run.py --quick    # fewer repetitions, no notebooks
     python benchmarks/run.py --browser  # everything, plus the browser benchmark
     python benchmarks/run.py --browser-only   # only the browser benchmark (benchmarks/browser.py)
+    python benchmarks/run.py --grading        # everything, plus the grader (python -m coursekit grade)
+    python benchmarks/run.py --grading-only   # only the grader benchmark
 
 Each pair of competitors is timed in interleaved repetitions (a, b, a, b, ...)
 so that drift in the machine's speed affects both alike; the table reports
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import os
 import statistics
 import subprocess
 import sys
@@ -283,13 +286,15 @@ ABOUT = {
                "same session, and the figures painted per second while dragging it, right after Run All "
                "(first drag) and again after the steps. An explorer is light when its kernel compute + "
                "redraw is at most 25 ms.",
+    "grading": "`python -m coursekit grade` on copies of chapter 1's student edition: notebooks graded per "
+               "minute with two at a time against one at a time, and grading one notebook against a plain "
+               "`jupyter nbconvert --execute` of it (both start a fresh kernel).",
 }
 
 
 def write_docs(path: Path, command: str, report: list[str]) -> None:
     """docs/performance.md: how the numbers were made, then the tables of this run."""
     import datetime
-    import os
     head = ["# Performance", "",
             "Written by `benchmarks/run.py` (do not edit by hand): run it again to refresh every table.",
             f"This run: `{command}` on {datetime.date.today().isoformat()}, {os.cpu_count()} cores. "
@@ -297,6 +302,46 @@ def write_docs(path: Path, command: str, report: list[str]) -> None:
             "by the ratios, which hold across machines better than the times.", ""]
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text("\n".join(head + report) + "\n", encoding="utf-8")
+
+
+def _student_submissions(folder: Path, count: int) -> Path:
+    """`count` copies of chapter 1's student edition in `folder` (student ids s01, s02, ...)."""
+    from coursekit.release import read_notebook, student_edition, write_notebook
+    nb = student_edition(read_notebook(ROOT / "notebooks" / "01_representations.ipynb"))
+    folder.mkdir(parents=True, exist_ok=True)
+    for i in range(1, count + 1):
+        write_notebook(nb, folder / f"s{i:02d}.ipynb")
+    return folder
+
+
+def _nbconvert(path: Path, out: Path) -> None:
+    subprocess.run([sys.executable, "-m", "jupyter", "nbconvert", "--to", "notebook", "--execute",
+                    str(path), "--output-dir", str(out)], check=True, capture_output=True, cwd=path.parent)
+
+
+def bench_grading(repeat: int, count: int = 6) -> list[str]:
+    """The grader on copies of chapter 1's student edition: notebooks graded per minute with two
+    at a time against one at a time, and the time to grade one notebook against a plain
+    ``jupyter nbconvert --to notebook --execute`` of it (both start a fresh kernel)."""
+    import tempfile
+    from coursekit.grading import grade
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        many, one = _student_submissions(tmp / "many", count), _student_submissions(tmp / "one", 1)
+        med = interleaved({"jobs 1": lambda: grade(many, tmp / "g1", chapter=1, jobs=1),
+                           "jobs 2": lambda: grade(many, tmp / "g2", chapter=1, jobs=2),
+                           "grade one": lambda: grade(one, tmp / "g", chapter=1, jobs=1),
+                           "nbconvert": lambda: _nbconvert(one / "s01.ipynb", tmp / "nbconvert")}, repeat)
+    per_minute = {jobs: 60 * count / med[jobs] for jobs in ("jobs 1", "jobs 2")}
+    load = os.getloadavg()[1] if hasattr(os, "getloadavg") else float("nan")
+    return ["| measure | value | target |", "|---|---|---|",
+            f"| machine load average (5 min) at the end, {os.cpu_count()} cores | {load:.1f} | |",
+            f"| notebooks graded per minute, --jobs 1 ({count} notebooks) | {per_minute['jobs 1']:.1f} | |",
+            f"| notebooks graded per minute, --jobs 2 | {per_minute['jobs 2']:.1f} | |",
+            f"| speed-up --jobs 2 / --jobs 1 | {per_minute['jobs 2'] / per_minute['jobs 1']:.2f} | >= 1.6 |",
+            f"| grading one notebook | {med['grade one']:.1f} s | |",
+            f"| jupyter nbconvert --execute of it | {med['nbconvert']:.1f} s | |",
+            f"| grader / nbconvert | {med['grade one'] / med['nbconvert']:.2f} | <= 1.3 |"]
 
 
 def main() -> None:
@@ -307,6 +352,9 @@ def main() -> None:
     parser.add_argument("--browser-only", action="store_true", help="run only the browser benchmark")
     parser.add_argument("--explorer", action="append", default=None, metavar="chN.name_explorer",
                         help="browser benchmark: only this explorer (repeatable)")
+    parser.add_argument("--grading", action="store_true",
+                        help="add the grader benchmark (python -m coursekit grade on chapter 1 copies)")
+    parser.add_argument("--grading-only", action="store_true", help="run only the grader benchmark")
     parser.add_argument("--screenshots", type=Path, default=None, metavar="DIR",
                         help="browser benchmark: save a screenshot of each notebook after its drag")
     parser.add_argument("--docs", action="store_true",
@@ -328,6 +376,12 @@ def main() -> None:
         sections.append(browser_section)
     if args.browser_only:
         sections = [browser_section]
+    grading_section = ("grading: chapter 1 student edition, fresh kernel per notebook", bench_grading,
+                       1 if args.quick else 3)
+    if args.grading:
+        sections.append(grading_section)
+    if args.grading_only:
+        sections = [grading_section]
     print(f"coursekit benchmarks, Python {sys.version.split()[0]}, numpy {np.__version__}\n")
     report = [f"Python {sys.version.split()[0]}, numpy {np.__version__}.", ""]
     for title, func, reps in sections:

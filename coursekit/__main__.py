@@ -129,8 +129,59 @@ def _run_site(args) -> int:
     return 0
 
 
+_NOT_A_SANDBOX = (
+    "This is not a sandbox: a notebook runs with your rights and can read (and change) every file you "
+    "can. For untrusted notebooks, or many of them, run the grader in a container with only the "
+    "submissions and the output folder mounted, e.g. docker run --rm --network none -v "
+    "\"$PWD/submissions:/submissions:ro\" -v \"$PWD/grades:/grades\" IMAGE python -m coursekit grade "
+    "--chapter 1 /submissions --out /grades (IMAGE: any image with coursekit[grade] installed; "
+    "podman takes the same arguments). See docs/grading.md.")
+
+
+def _add_grade(commands) -> None:
+    parser = commands.add_parser(
+        "grade", help="grade a folder of submitted notebooks (grades.csv and feedback per student)",
+        description="Execute each submitted notebook of SUBMISSIONS (file name stem = student id) top to "
+                    "bottom in a fresh kernel of its own, in a temporary folder holding only a copy of it, "
+                    "with a time and a memory limit; record the answers its check_* calls receive and "
+                    "check the last answer to each exercise again with the course's own checks, outside "
+                    "the notebook (a check replaced or patched in the notebook awards nothing). Writes "
+                    "DIR/grades.csv (one row per student: 1 or 0 per exercise, total, status) and "
+                    "DIR/feedback/STUDENT.md (what each check says about the answer, never the solution). "
+                    "Needs the grade extra: python -m pip install -e \".[grade]\". "
+                    "Statuses: " + "; ".join(f"{k}: {v}" for k, v in _statuses().items()) + ". "
+                    + _NOT_A_SANDBOX)
+    parser.add_argument("submissions", type=Path, metavar="SUBMISSIONS",
+                        help="folder of the submitted notebooks (*.ipynb), one per student")
+    parser.add_argument("--chapter", required=True, type=int, metavar="N",
+                        help="the chapter the notebooks are (1, 2, 3 or 4)")
+    parser.add_argument("--out", required=True, type=Path, metavar="DIR",
+                        help="folder for grades.csv and feedback/ (created when missing; an earlier "
+                             "grades.csv and feedback/*.md there are replaced)")
+    parser.add_argument("--timeout", type=float, default=300, metavar="SECONDS",
+                        help="time limit of each notebook, all cells together (default: 300)")
+    parser.add_argument("--memory", default="4G", metavar="SIZE",
+                        help="address-space limit of each notebook's kernel, e.g. 4G or 512M (default: 4G)")
+    parser.add_argument("--jobs", type=int, default=None, metavar="N",
+                        help="notebooks run at once (default: the number of cores)")
+    parser.set_defaults(run=_run_grade)
+
+
+def _statuses() -> dict:
+    from .grading import STATUSES
+    return STATUSES
+
+
+def _run_grade(args) -> int:
+    from .grading import grade
+    table = grade(args.submissions, args.out, chapter=args.chapter, timeout=args.timeout,
+                  memory=args.memory, jobs=args.jobs)
+    print(f"grades written to {table}, feedback to {table.parent / 'feedback'}")
+    return 0
+
+
 #: one function per command, in the order of --help
-COMMANDS = (_add_release, _add_slides, _add_colab, _add_site)
+COMMANDS = (_add_release, _add_slides, _add_colab, _add_site, _add_grade)
 
 
 def build_parser() -> argparse.ArgumentParser:

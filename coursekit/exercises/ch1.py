@@ -17,6 +17,7 @@ import numpy as np
 from .. import models
 from ..realization import euler_discretize, ode_to_ss
 from ..systems import StateSpace
+from ._catalog import exercise
 from ._data import ExerciseData
 from ._feedback import CheckResult, Report, call_student_function, close, matrix_feedback
 
@@ -44,6 +45,8 @@ ODE = ExerciseData({"a": (3.0, 5.0, 2.0), "b": 4.0})
 EULER = ExerciseData({"A": ((0.0, 1.0), (-2.0, -3.0)), "B": ((0.0,), (1.0,)), "Ts": 0.1})
 
 
+@exercise("1.1", "the mass-spring-damper in state-space form",
+          section="1.6 Bridges")
 def check_msd_state_space(A, B, C) -> CheckResult:
     """Check A, B, C of the mass-spring-damper `MSD` with x = [y, y'] and y the position."""
     report = Report("mass-spring-damper")
@@ -64,6 +67,8 @@ def check_msd_state_space(A, B, C) -> CheckResult:
     return report.show("x' = A x + B u, y = C x is the mass-spring-damper (1.57).")
 
 
+@exercise("1.2", "the compartment model in state-space form",
+          section="1.2 A few systems")
 def check_compartment_state_space(A, B, C) -> CheckResult:
     """Check A, B, C of the compartment model `COMPARTMENT` with x = [c1, c2], y = c2."""
     report = Report("compartment model")
@@ -99,6 +104,8 @@ def _student_f(f, x, u, report: Report):
     return out
 
 
+@exercise("1.3", "the nonlinear pendulum as x' = f(x, u)",
+          section="1.2 A few systems")
 def check_pendulum_f(f) -> CheckResult:
     """Check a Python function ``f(x, u)`` returning [theta', theta''] for the pendulum (1.8).
 
@@ -147,6 +154,8 @@ def check_pendulum_f(f) -> CheckResult:
     return report.show("")
 
 
+@exercise("1.4", "from an ODE to a state-space form",
+          section="1.6 Bridges")
 def check_ode_realization(A, B, C) -> CheckResult:
     """Check the realization of the `ODE` with state x = [y, y', y''] (1.48)-(1.53)."""
     report = Report("ODE realization")
@@ -171,6 +180,8 @@ def check_ode_realization(A, B, C) -> CheckResult:
     return report.show("this is the realization (1.52)-(1.53) of the ODE.")
 
 
+@exercise("1.5", "Euler discretization",
+          section="1.6 Bridges")
 def check_euler_discretization(Ad, Bd) -> CheckResult:
     """Check x(t+1) = Ad x(t) + Bd u(t), the Euler discretization (1.43) of `EULER`."""
     from scipy.linalg import expm

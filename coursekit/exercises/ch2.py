@@ -14,6 +14,7 @@ import numpy as np
 
 from ..controllability import ccf_transform, ctrb
 from ..flatness import car_like_flatness
+from ._catalog import exercise
 from ._data import ExerciseData
 from ._feedback import CheckResult, Report, close, matrix_feedback, rank_decision_feedback, read_numbers
 
@@ -51,6 +52,8 @@ def _blocks(A: np.ndarray, B: np.ndarray) -> list[np.ndarray]:
     return blocks
 
 
+@exercise("2.1", "the controllability matrix",
+          section="2.2 Controllability and the Kalman criterion")
 def check_ctrb_matrix(Wc) -> CheckResult:
     """Check the controllability matrix Wc = [B, AB, A^2 B] of `CTRB` (2.13)."""
     report = Report("controllability matrix")
@@ -65,6 +68,8 @@ def check_ctrb_matrix(Wc) -> CheckResult:
     return report.show("Wc = [B, AB, A^2 B] (2.13).")
 
 
+@exercise("2.2", "Kalman's criterion",
+          section="2.2 Controllability and the Kalman criterion")
 def check_kalman_decision(rank, controllable) -> CheckResult:
     """Check the rank of Wc for `KALMAN` and the decision of Kalman's criterion."""
     report = Report("Kalman criterion")
@@ -78,6 +83,8 @@ def check_kalman_decision(rank, controllable) -> CheckResult:
     return report.show("rank Wc decides controllability (Kalman's criterion).")
 
 
+@exercise("2.3", "the transform to the CCF",
+          section="2.3 Open-loop control")
 def check_ccf_transform(T) -> CheckResult:
     """Check the transform z = T x that puts `CCF` in controllability canonical form (2.65)."""
     report = Report("CCF transform")
@@ -103,6 +110,8 @@ def _car_solution(sign: float) -> tuple[float, float]:
     return float(v), float(delta)
 
 
+@exercise("2.4", "the car-like robot is flat",
+          section="2.4 Flatness")
 def check_car_flatness(v, delta) -> CheckResult:
     """Check the speed v [m/s] and steering angle delta [rad] of the car-like robot at `CAR`.
 
@@ -144,6 +153,8 @@ def check_car_flatness(v, delta) -> CheckResult:
                        "with F = (x1, x2) and therefore controllable.")
 
 
+@exercise("2.5", "a polynomial trajectory",
+          section="2.3 Open-loop control")
 def check_trajectory_coefficients(alpha) -> CheckResult:
     """Check [alpha0, alpha1, alpha2, alpha3] of y_d(t) for `TRAJECTORY` (2.33)-(2.38)."""
     report = Report("trajectory coefficients")

@@ -16,6 +16,7 @@ from .. import models
 from ..linearization import linearize
 from ..placement import place
 from ..stability import is_stable
+from ._catalog import exercise
 from ._data import ExerciseData
 from ._feedback import CheckResult, Report, matrix_feedback, read_decision
 
@@ -45,6 +46,8 @@ PLACE_GENERAL = ExerciseData({"A": ((1.0, 2.0), (3.0, 0.0)), "B": ((0.0,), (1.0,
 LINEARIZE = ExerciseData({"m": 0.5, "l": 0.8, "g": 9.81, "d_theta": 0.3, "x_eq": (np.pi, 0.0)})
 
 
+@exercise("3.1", "stable or not?",
+          section="3.2 Stability of linear time-invariant systems")
 def check_stability(answers) -> CheckResult:
     """Check a list of four True/False: is x' = A x stable, for A1 ... A4 of `STABILITY`?"""
     report = Report("stability")
@@ -100,6 +103,8 @@ def _check_gain(K, data: ExerciseData, title: str, hint: str, praise: str) -> Ch
     return report.show(praise)
 
 
+@exercise("3.2", "pole placement for a CCF",
+          section="3.3 Stabilization of LTI systems by state feedback")
 def check_gain_ccf(K) -> CheckResult:
     """Check the gain K (u = K x) placing the poles of `PLACE_CCF`, from (3.42)-(3.44)."""
     return _check_gain(K, PLACE_CCF, "pole placement in CCF",
@@ -108,6 +113,8 @@ def check_gain_ccf(K) -> CheckResult:
                        praise="eig(A + B K) are the wanted poles (3.44).")
 
 
+@exercise("3.3", "pole placement, the general case",
+          section="3.3 Stabilization of LTI systems by state feedback")
 def check_gain_general(K) -> CheckResult:
     """Check the gain K (u = K x) placing the poles of `PLACE_GENERAL` via the CCF (3.46)-(3.47)."""
     return _check_gain(K, PLACE_GENERAL, "pole placement, general case",
@@ -116,6 +123,8 @@ def check_gain_general(K) -> CheckResult:
                        praise="eig(A + B K) are the wanted poles, K = K~ T (3.47).")
 
 
+@exercise("3.4", "linearize the pendulum at the top",
+          section="3.4 Linear state feedback for nonlinear systems")
 def check_pendulum_linearization(A, B) -> CheckResult:
     """Check (A, B) of the pendulum `LINEARIZE` linearized at theta = pi, theta' = 0 (3.67)."""
     report = Report("linearized pendulum")

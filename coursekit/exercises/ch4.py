@@ -13,6 +13,7 @@ import numpy as np
 from ..observability import obsv, place_observer
 from ..observers import separation_eigenvalues
 from ..systems import StateSpace
+from ._catalog import exercise
 from ._data import ExerciseData
 from ._feedback import (CheckResult, Report, matrix_feedback, poles_feedback, rank_decision_feedback,
                         read_poles)
@@ -39,6 +40,8 @@ SEPARATION = ExerciseData({"A": ((0.0, 1.0), (3.0, -2.0)), "B": ((0.0,), (1.0,))
                            "K": ((-9.0, -3.0),), "L": ((7.0,), (9.0,))})
 
 
+@exercise("4.1", "the observability matrix",
+          section="4.2 Observability and the Kalman criterion")
 def check_obsv_matrix(Wo) -> CheckResult:
     """Check the observability matrix Wo = [C; CA; CA^2] of `OBSV` (4.15)."""
     report = Report("observability matrix")
@@ -53,6 +56,8 @@ def check_obsv_matrix(Wo) -> CheckResult:
     return report.show("Wo = [C; CA; CA^2] (4.15).")
 
 
+@exercise("4.2", "a car with only a speedometer",
+          section="4.2 Observability and the Kalman criterion")
 def check_vehicle_observability(rank, observable) -> CheckResult:
     """Check the rank of Wo for `VEHICLE` and whether it is observable (section 4.2.3)."""
     report = Report("vehicle observability")
@@ -66,6 +71,8 @@ def check_vehicle_observability(rank, observable) -> CheckResult:
     return report.show("rank Wo decides observability; a speedometer never reveals the position.")
 
 
+@exercise("4.3", "an observer gain by hand",
+          section="4.3 State estimation using observers")
 def check_observer_gain(L) -> CheckResult:
     """Check the observer gain L with eig(A - L C) = the poles of `OBSERVER` (4.27)."""
     report = Report("observer gain")
@@ -88,6 +95,8 @@ def check_observer_gain(L) -> CheckResult:
     return report.show("eig(A - L C) are the wanted error poles (4.27).")
 
 
+@exercise("4.4", "output feedback and the separation of poles",
+          section="4.6 Output feedback using an observer")
 def check_separation_poles(poles) -> CheckResult:
     """Check the 4 eigenvalues of the output-feedback loop of `SEPARATION` (plant + observer)."""
     report = Report("output feedback")
