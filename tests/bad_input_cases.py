@@ -17,7 +17,8 @@ says)`: a `check_*` exercise, which must print "Not yet" feedback matching
 line into the standard set of bad values for a matrix, a scalar, a list of
 poles or a user function.
 
-Run as a script, this module is the worker: it reads case ids (one per line)
+`main()` is the worker, started by tests/test_bad_input.py in a process of its
+own once the whole module (cases added at its end included) is imported: it reads case ids (one per line)
 on stdin, runs each under a per-case deadline and prints one JSON line per
 case (and a "start" line before it, so that the parent can tell which case a
 killed worker was running).
@@ -982,7 +983,3 @@ def main() -> None:
             signal.alarm(0)
             faulthandler.cancel_dump_traceback_later()
         print(MARK + json.dumps(dict(verdict, id=case.id, seconds=time.perf_counter() - start)), flush=True)
-
-
-if __name__ == "__main__":
-    main()

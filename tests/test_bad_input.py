@@ -26,7 +26,8 @@ import coursekit as ck
 from coursekit import models
 from coursekit.chapters import chapter_modules, check_functions
 
-WORKER = Path(table.__file__)
+#: the worker: the whole table imported (cases added at its end too), then its main loop
+WORKER = f"import sys; sys.path.insert(0, {str(Path(table.__file__).parent)!r}); import bad_input_cases; bad_input_cases.main()"
 #: a worker that prints nothing for this long is stuck outside any case's deadline
 #: (the per-case alarm and fault handler act within DEADLINE + 5 s; the rest is for
 #: importing the libraries on a loaded machine) and is killed
@@ -45,7 +46,7 @@ def _worker_lines(ids: list[str], env: dict):
     with tempfile.TemporaryFile("w+") as todo_file, tempfile.TemporaryFile("w+") as err_file:
         todo_file.write("\n".join(ids) + "\n")
         todo_file.seek(0)
-        proc = subprocess.Popen([sys.executable, str(WORKER)], stdin=todo_file, stdout=subprocess.PIPE,
+        proc = subprocess.Popen([sys.executable, "-c", WORKER], stdin=todo_file, stdout=subprocess.PIPE,
                                 stderr=err_file, text=True, env=env)
         lines: queue.Queue = queue.Queue()
         threading.Thread(target=lambda: [*map(lines.put, proc.stdout), lines.put("")], daemon=True).start()

@@ -26,7 +26,7 @@ def test_every_section_heading_is_a_slide_and_every_subsection_a_subslide(path):
         elif first.startswith(("### ", "#### ")):
             assert _stored(cell) == "subslide", first
             headings[3] += 1
-    assert headings[2] >= 5 and headings[3] >= 3, headings
+    assert headings[2] >= 2 and headings[3] >= 1, headings     # sections, at least the exercises
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)

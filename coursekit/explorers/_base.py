@@ -194,6 +194,11 @@ class Explorer:
         self.frames = FrameRenderer(self.fig)
         self._png = self.frames.frame()
         self._widget = self._view = self._text = None
+        # every callback on the kernel's main thread, whichever thread a message arrives on
+        from ._home import HomeThread
+        self._home = HomeThread()
+        for w in self.controls.values():
+            w.observe(lambda change: self._home.run(self.refresh, key="refresh"), names="value")
 
     @staticmethod
     def _check(title, controls, functions: dict) -> None:
@@ -299,18 +304,13 @@ class Explorer:
         if self._widget is None:
             import ipywidgets as widgets
 
-            from ._home import HomeThread
             from ._view import FigureView
             width, height = self.frames.canvas.get_width_height(physical=True)
             self._view = FigureView(png=self._png, alt=self.alt, css_width=float(width),
                                     css_height=float(height))
             self._text = widgets.HTML(self._readout_html())
             self._text.add_class("ck-readout-box")
-            # every callback on the kernel's main thread, whichever thread a message arrives on
-            home = HomeThread()
-            self._view.observe(lambda change: home.run(self._on_latest_screen, key="screen"), names="screen")
-            for w in self.controls.values():
-                w.observe(lambda change: home.run(self.refresh, key="refresh"), names="value")
+            self._view.observe(lambda change: self._home.run(self._on_latest_screen, key="screen"), names="screen")
             header = widgets.HTML(f"<b>{html.escape(self.title)}</b>")
             header.add_class("ck-title")
             column = "270px" if self.lecture else "300px"
