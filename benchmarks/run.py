@@ -102,8 +102,8 @@ def bench_place(repeat: int) -> list[str]:
 
 
 def explorer_factories():
-    """Every explorer of the course, found by `coursekit.chapters` (a new chapter's too)."""
-    from coursekit.chapters import explorer_factories as found
+    """Every explorer of the course, found by `coursekit.tools.chapters` (a new chapter's too)."""
+    from coursekit.tools.chapters import explorer_factories as found
     return found().items()
 
 
@@ -306,7 +306,7 @@ def write_docs(path: Path, command: str, report: list[str]) -> None:
 
 def _student_submissions(folder: Path, count: int) -> Path:
     """`count` copies of chapter 1's student edition in `folder` (student ids s01, s02, ...)."""
-    from coursekit.release import read_notebook, student_edition, write_notebook
+    from coursekit.tools.release import read_notebook, student_edition, write_notebook
     nb = student_edition(read_notebook(ROOT / "notebooks" / "01_representations.ipynb"))
     folder.mkdir(parents=True, exist_ok=True)
     for i in range(1, count + 1):
@@ -324,7 +324,7 @@ def bench_grading(repeat: int, count: int = 6) -> list[str]:
     at a time against one at a time, and the time to grade one notebook against a plain
     ``jupyter nbconvert --to notebook --execute`` of it (both start a fresh kernel)."""
     import tempfile
-    from coursekit.grading import grade
+    from coursekit.tools.grading import grade
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
         many, one = _student_submissions(tmp / "many", count), _student_submissions(tmp / "one", 1)

@@ -4,7 +4,7 @@ Each command is one small function ``_add_<command>(commands)`` that adds its
 parser to the subparsers `commands` and sets ``run`` to a function taking the
 parsed arguments and returning the exit status; `COMMANDS` lists them in the
 order ``--help`` shows them. The work itself lives in a module of the package
-(`coursekit.release`, `coursekit.slides`, ...) whose functions take paths, so
+(`coursekit.tools.release`, `coursekit.tools.slides`, ...) whose functions take paths, so
 the same work is done from Python and tested there.
 
 A bad argument (a folder that is not empty, a missing notebooks folder) stops
@@ -40,7 +40,7 @@ def _add_release(commands) -> None:
 
 
 def _run_release(args) -> int:
-    from .release import build_release
+    from .tools.release import build_release
     written = build_release(args.out, notebooks=args.notebooks, force=args.force)
     print(f"student edition: {len(written)} notebooks written to {args.out}")
     for path in written:
@@ -64,7 +64,7 @@ def _add_slides(commands) -> None:
 
 
 def _run_slides(args) -> int:
-    from .slides import apply_slide_metadata
+    from .tools.slides import apply_slide_metadata
     changed = apply_slide_metadata(args.notebooks, write=not args.check)
     if args.check:
         for path in changed:
@@ -91,8 +91,8 @@ def _add_colab(commands) -> None:
 
 
 def _run_colab(args) -> int:
-    from .colab import apply_install_cell, repository_from_git
-    from .release import default_notebook_dir
+    from .tools.colab import apply_install_cell, repository_from_git
+    from .tools.release import default_notebook_dir
     folder = args.notebooks or default_notebook_dir()
     repository = args.repository or repository_from_git(folder)
     if repository is None:
@@ -121,7 +121,7 @@ def _add_site(commands) -> None:
 
 
 def _run_site(args) -> int:
-    from .site import build_site
+    from .tools.site import build_site
     index = build_site(args.out, student=args.student, notebooks_dir=args.notebooks, verbose=True)
     print(f"site written to {index.parent}\n"
           f"view it: python -m http.server -b 127.0.0.1 -d {index.parent}  (then open "
@@ -168,12 +168,12 @@ def _add_grade(commands) -> None:
 
 
 def _statuses() -> dict:
-    from .grading import STATUSES
+    from .tools.grading import STATUSES
     return STATUSES
 
 
 def _run_grade(args) -> int:
-    from .grading import grade
+    from .tools.grading import grade
     table = grade(args.submissions, args.out, chapter=args.chapter, timeout=args.timeout,
                   memory=args.memory, jobs=args.jobs)
     print(f"grades written to {table}, feedback to {table.parent / 'feedback'}")

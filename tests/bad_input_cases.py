@@ -46,7 +46,7 @@ import coursekit as ck
 import coursekit.exercises as ex
 from coursekit.exercises._feedback import CheckResult
 from coursekit import models
-from coursekit.chapters import check_functions
+from coursekit.tools.chapters import check_functions
 from coursekit.explorers import ch1 as xp1, ch2 as xp2, ch3 as xp3, ch4 as xp4
 
 #: seconds a single case may take before it counts as a hang (the slowest good case

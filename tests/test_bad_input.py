@@ -24,7 +24,7 @@ import pytest
 import bad_input_cases as table
 import coursekit as ck
 from coursekit import models
-from coursekit.chapters import chapter_modules, check_functions
+from coursekit.tools.chapters import chapter_modules, check_functions
 
 #: the worker: the whole table imported (cases added at its end too), then its main loop
 WORKER = f"import sys; sys.path.insert(0, {str(Path(table.__file__).parent)!r}); import bad_input_cases; bad_input_cases.main()"

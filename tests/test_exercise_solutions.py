@@ -25,7 +25,7 @@ from pathlib import Path
 
 import pytest
 
-from coursekit.chapters import chapter_notebooks
+from coursekit.tools.chapters import chapter_notebooks
 from coursekit.exercises._feedback import CheckResult
 
 NOTEBOOKS = chapter_notebooks(Path(__file__).resolve().parents[1] / "notebooks")

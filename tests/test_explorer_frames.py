@@ -8,7 +8,7 @@ import pytest
 from matplotlib.figure import Figure
 
 import coursekit as ck
-from coursekit.chapters import explorer_factories
+from coursekit.tools.chapters import explorer_factories
 from coursekit.explorers import ch1, ch3, rescale
 from coursekit.explorers import _base
 from coursekit.explorers._base import MIN_SCALE

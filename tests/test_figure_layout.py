@@ -17,7 +17,7 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
 import coursekit as ck  # noqa: E402
-from coursekit.chapters import explorer_factories  # noqa: E402
+from coursekit.tools.chapters import explorer_factories  # noqa: E402
 from coursekit.explorers import ch1  # noqa: E402
 from layout_check import legend_problems, text_problems  # noqa: E402
 

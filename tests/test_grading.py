@@ -30,8 +30,8 @@ from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 
 from coursekit.__main__ import main
 from coursekit.exercises._catalog import chapter_exercises
-from coursekit.grading import grade, parse_memory
-from coursekit.release import default_notebook_dir, read_notebook, student_edition
+from coursekit.tools.grading import grade, parse_memory
+from coursekit.tools.release import default_notebook_dir, read_notebook, student_edition
 
 SOLUTION = re.compile(r"```python\n(?P<code>.*?)\n```", re.S)
 CHECKS = [entry.check for entry in chapter_exercises(1)]

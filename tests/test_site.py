@@ -1,4 +1,4 @@
-"""The course website's pieces (coursekit.site) and one small build without a browser.
+"""The course website's pieces (coursekit.tools.site) and one small build without a browser.
 
 The full build of the four chapters, checked page by page in Chromium, is in
 tests/test_site_browser.py (marker ``browser``). Here: the markdown and notebook rewrites, the
@@ -16,8 +16,8 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from coursekit import site
-from coursekit.chapters import chapter_notebooks
+from coursekit.tools import site
+from coursekit.tools.chapters import chapter_notebooks
 from coursekit.__main__ import main
 
 NOTEBOOKS = Path(__file__).parents[1] / "notebooks"

@@ -25,8 +25,8 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from coursekit import site
-from coursekit.chapters import chapter_notebooks
+from coursekit.tools import site
+from coursekit.tools.chapters import chapter_notebooks
 
 import lab_harness  # the browser test's Chromium location and settings
 
@@ -36,7 +36,7 @@ NOTEBOOKS = Path(__file__).parents[1] / "notebooks"
 CHAPTERS = [p.stem for p in chapter_notebooks(NOTEBOOKS)]
 PAGES = ["index", *CHAPTERS, "genindex", "search"]
 EDITIONS = ["instructor", "student"]
-ERRATUM_BACKGROUND = "rgb(255, 247, 237)"   # coursekit.site.CSS, light mode
+ERRATUM_BACKGROUND = "rgb(255, 247, 237)"   # coursekit.tools.site.CSS, light mode
 _ERRATUM_SOURCE = re.compile(r"\*\*(?:Erratum|Remark\s*/\s*erratum)\b", re.IGNORECASE)
 _EXPLORER_CALL = re.compile(r"\b\w+_explorer\(")
 

@@ -4,8 +4,8 @@ import nbformat
 import pytest
 
 from coursekit.__main__ import main
-from coursekit.release import default_notebook_dir, read_notebook
-from coursekit.slides import apply_slide_metadata, slide_types, with_slide_metadata
+from coursekit.tools.release import default_notebook_dir, read_notebook
+from coursekit.tools.slides import apply_slide_metadata, slide_types, with_slide_metadata
 
 NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))
 

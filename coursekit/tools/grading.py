@@ -3,7 +3,7 @@
 `grade` executes every ``*.ipynb`` of SUBMISSIONS (the file name's stem is the
 student's id), each in a fresh kernel of its own, in a temporary working folder
 holding a copy of that notebook only, with a time limit for the whole notebook
-and a memory limit for its kernel, `jobs` at a time (`coursekit._notebook_run`).
+and a memory limit for its kernel, `jobs` at a time (`coursekit.tools._notebook_run`).
 While a notebook runs, each call of a course ``check_*`` appends the answer
 to a file the grader reads afterwards (`coursekit.exercises._answers`). The
 grader then checks the last answer given to each exercise of the chapter again,
@@ -88,7 +88,7 @@ def parse_memory(text: str) -> int:
 def _chapter_of(nb) -> int | None:
     """The chapter a notebook is: its title ("# Chapter 2 ..."), else the one chapter whose
     checks its code calls; None when neither tells."""
-    from .exercises._catalog import CATALOG
+    from ..exercises._catalog import CATALOG
     for cell in nb.cells:
         if cell.cell_type == "markdown":
             match = re.search(r"^#\s+Chapter\s+(\d+)", cell.source, re.M)
@@ -115,10 +115,10 @@ def _read_submission(path: Path, chapter: int):
 
 
 def _runner_env(answers: Path) -> dict:
-    from .exercises._answers import ANSWERS_ENV
+    from ..exercises._answers import ANSWERS_ENV
     env = dict(os.environ)
     env[ANSWERS_ENV] = str(answers)
-    package_root = str(Path(__file__).resolve().parents[1])
+    package_root = str(Path(__file__).resolve().parents[2])
     env["PYTHONPATH"] = os.pathsep.join(p for p in (package_root, env.get("PYTHONPATH")) if p)
     return env
 
@@ -135,7 +135,7 @@ def _stop(process: subprocess.Popen) -> None:
 
 def _run_notebook(nb, student: str, timeout: float, memory: int) -> tuple[str, str, list[dict]]:
     """Execute a copy of `nb` in a folder of its own; (status, detail, answers recorded)."""
-    from .exercises._answers import read_records
+    from ..exercises._answers import read_records
     # a notebook may leave files it made unremovable: that must not cost it its grades
     with tempfile.TemporaryDirectory(prefix="coursekit-grade-", ignore_cleanup_errors=True) as box:
         work, private = Path(box) / "work" / "submission", Path(box) / "private"
@@ -152,7 +152,7 @@ def _run_notebook(nb, student: str, timeout: float, memory: int) -> tuple[str, s
 
 
 def _execute(notebook: Path, private: Path, timeout: float, memory: int, env: dict) -> tuple[str, str]:
-    command = [sys.executable, "-m", "coursekit._notebook_run", str(notebook), str(private / "kernels"),
+    command = [sys.executable, "-m", "coursekit.tools._notebook_run", str(notebook), str(private / "kernels"),
                str(timeout), str(memory)]
     process = subprocess.Popen(command, cwd=notebook.parent, env=env, stdout=subprocess.PIPE,
                                stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, text=True,
@@ -172,7 +172,7 @@ def _execute(notebook: Path, private: Path, timeout: float, memory: int, env: di
 
 def _check_again(check, arguments: dict) -> tuple[bool, str]:
     """Run the course's own check on a recorded answer: (correct, the feedback it printed)."""
-    from .exercises._answers import decode
+    from ..exercises._answers import decode
     printed = io.StringIO()
     try:
         with contextlib.redirect_stdout(printed), warnings.catch_warnings():
@@ -185,8 +185,8 @@ def _check_again(check, arguments: dict) -> tuple[bool, str]:
 
 def grade_answers(records: list[dict], chapter: int) -> tuple[dict[str, int], dict[str, str]]:
     """Scores and feedback per check of `chapter` from the recorded answers (the last one counts)."""
-    from . import exercises
-    from .exercises._catalog import chapter_exercises
+    from .. import exercises
+    from ..exercises._catalog import chapter_exercises
     last = {record["check"]: record["args"] for record in records}
     scores, feedback = {}, {}
     for entry in chapter_exercises(chapter):
@@ -217,7 +217,7 @@ def _grade_one(path: Path, chapter: int, timeout: float, memory: int) -> Outcome
 
 
 def _feedback_text(outcome: Outcome, chapter: int) -> str:
-    from .exercises._catalog import chapter_exercises
+    from ..exercises._catalog import chapter_exercises
     total = sum(outcome.scores.values())
     lines = [f"# Feedback for {outcome.student}: chapter {chapter}", "",
              f"Status: **{outcome.status}**: {outcome.detail}. ({STATUSES[outcome.status]})", "",
@@ -229,7 +229,7 @@ def _feedback_text(outcome: Outcome, chapter: int) -> str:
 
 
 def _write(outcomes: list[Outcome], chapter: int, out: Path) -> Path:
-    from .exercises._catalog import chapter_exercises
+    from ..exercises._catalog import chapter_exercises
     checks = [entry.check for entry in chapter_exercises(chapter)]
     feedback_dir = out / "feedback"
     feedback_dir.mkdir(parents=True, exist_ok=True)
@@ -256,7 +256,7 @@ def _require_tools() -> None:
 
 
 def _check_arguments(submissions: Path, out: Path, chapter, timeout, jobs) -> None:
-    from .exercises._catalog import chapter_exercises
+    from ..exercises._catalog import chapter_exercises
     chapter_exercises(chapter)
     if not submissions.is_dir():
         raise ValueError(f"submissions: {submissions} is not a folder; pass the folder of submitted notebooks")

@@ -72,7 +72,7 @@ def default_notebook_dir() -> Path:
     with ``pip install -e``; otherwise (``pip install .``, as on Binder)
     ``notebooks/`` in the current folder.
     """
-    beside = Path(__file__).resolve().parents[1] / "notebooks"
+    beside = Path(__file__).resolve().parents[2] / "notebooks"
     return beside if beside.is_dir() else Path.cwd() / "notebooks"
 
 
@@ -136,7 +136,7 @@ def student_edition(nb):
     """
     if not hasattr(nb, "cells") or not hasattr(nb, "metadata"):
         raise TypeError(f"nb must be a notebook (nbformat NotebookNode): received {type(nb).__name__}; "
-                        "read it with coursekit.release.read_notebook(path).")
+                        "read it with coursekit.tools.release.read_notebook(path).")
     nb = copy.deepcopy(nb)
     nb.cells = [cell for cell in nb.cells if not _is_solution(cell)]
     for cell in nb.cells:

@@ -1,6 +1,6 @@
 """Start an IPython kernel with a memory and a CPU-time limit (for the grader's kernels).
 
-``python -m coursekit._limited_kernel MEMORY_BYTES CPU_SECONDS -f CONNECTION_FILE ...``
+``python -m coursekit.tools._limited_kernel MEMORY_BYTES CPU_SECONDS -f CONNECTION_FILE ...``
 sets the kernel process's limits with `resource.setrlimit` (soft and hard, so
 the notebook cannot raise them again) and then replaces itself with the usual
 ``python -m ipykernel_launcher ...``, which keeps them:
@@ -26,7 +26,7 @@ __all__ = ["kernel_argv", "set_limits", "main"]
 
 def kernel_argv(memory_bytes: int, cpu_seconds: int) -> list[str]:
     """The ``argv`` of a kernel spec whose kernels start with these limits."""
-    return [sys.executable, "-m", "coursekit._limited_kernel", str(int(memory_bytes)), str(int(cpu_seconds)),
+    return [sys.executable, "-m", "coursekit.tools._limited_kernel", str(int(memory_bytes)), str(int(cpu_seconds)),
             "-f", "{connection_file}", "--HistoryManager.hist_file=:memory:"]
 
 

@@ -1,9 +1,9 @@
 """Execute one submitted notebook for the grader, in a process of its own.
 
-``python -m coursekit._notebook_run NOTEBOOK KERNELS_DIR TIMEOUT MEMORY_BYTES``
+``python -m coursekit.tools._notebook_run NOTEBOOK KERNELS_DIR TIMEOUT MEMORY_BYTES``
 runs every cell of NOTEBOOK top to bottom in a fresh kernel (nbclient) whose
 working folder is the notebook's folder, started from a kernel spec written to
-KERNELS_DIR that applies the memory limit (`coursekit._limited_kernel`). A
+KERNELS_DIR that applies the memory limit (`coursekit.tools._limited_kernel`). A
 cell that raises does not stop the run (the later exercises still count).
 TIMEOUT (seconds) bounds the whole notebook, not each cell.
 
