@@ -316,6 +316,11 @@ def _mode_reason(A, C, lam, v, dt, tol, closed_loop: bool, driven: bool) -> str 
     return None
 
 
+def _same_mode(lam: complex, v: np.ndarray, mu: complex, w: np.ndarray, tol: float) -> bool:
+    """The same eigenvalue (to `tol`) with a parallel unit eigenvector: one mode, listed once."""
+    return abs(lam - mu) <= max(tol, 1e-8 * abs(mu)) and abs(np.vdot(w, v)) > 1 - 1e-6
+
+
 def _no_stabilizing_solution(A, C, dt, lam, V, driven=None, *, solver: str = "",
                              closed_loop: bool = False) -> ValueError:
     """The ValueError of `kalman_gain`, naming the modes of A that prevent a stabilizing P.
@@ -329,11 +334,12 @@ def _no_stabilizing_solution(A, C, dt, lam, V, driven=None, *, solver: str = "",
     _, _, tol = _unstable_modes(A, dt)
     reasons, seen = [], []
     for k in range(lam.size):
-        # one of each conjugate pair, and one of a repeated eigenvalue (a Jordan block, whose
-        # eigenvectors coincide: the same paragraph twice)
-        if lam[k].imag < 0 or any(abs(lam[k] - other) <= max(tol, 1e-8 * abs(other)) for other in seen):
+        # one of each conjugate pair, and one eigenpair of a Jordan block (a repeated eigenvalue
+        # whose eigenvectors coincide: the same paragraph twice)
+        v = V[:, k] / np.linalg.norm(V[:, k])
+        if lam[k].imag < 0 or any(_same_mode(lam[k], v, mu, w, tol) for mu, w in seen):
             continue
-        seen.append(lam[k])
+        seen.append((lam[k], v))
         margin = -lam[k].real if dt is None else 1.0 - abs(lam[k])
         if not closed_loop and margin > tol:                 # a stable mode of A is harmless
             continue
