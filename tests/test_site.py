@@ -10,7 +10,10 @@ from __future__ import annotations
 
 import base64
 import html
+import os
 import re
+import subprocess
+import sys
 from pathlib import Path
 
 import nbformat
@@ -23,16 +26,16 @@ from coursekit.__main__ import main
 NOTEBOOKS = Path(__file__).parents[1] / "notebooks"
 
 
-def _code(source, tags=(), outputs=()):
-    cell = nbformat.v4.new_code_cell(source)
+def _code(source, tags=(), outputs=(), metadata=None):
+    cell = nbformat.v4.new_code_cell(source, metadata=dict(metadata or {}))
     if tags:
         cell.metadata["tags"] = list(tags)
     cell.outputs = list(outputs)
     return cell
 
 
-def _markdown(source, tags=()):
-    cell = nbformat.v4.new_markdown_cell(source)
+def _markdown(source, tags=(), metadata=None):
+    cell = nbformat.v4.new_markdown_cell(source, metadata=dict(metadata or {}))
     if tags:
         cell.metadata["tags"] = list(tags)
     return cell
@@ -201,6 +204,9 @@ PNG = base64.b64encode(bytes.fromhex(
 
 SMALL_NOTEBOOK = [
     _markdown("# Chapter 7 — A small chapter\n\nIntro with $\\dot x = A x$."),
+    _code("# install cell: pip install git+https://github.com/OWNER/NAME", metadata={"coursekit": "install"}),
+    _markdown("Run the environment check first.", metadata={"coursekit": "environment"}),
+    _code("print('BUILD-MACHINE-VERSIONS')", metadata={"coursekit": "environment"}),
     _markdown("## 7.1 First section\n\n> **Erratum (7.1).** The notes print $A^T$; it is $A$."),
     _code("from IPython.display import display\n"
           f"display({{'image/png': '{PNG}', 'text/plain': 'explorer (static figure)',\n"
@@ -226,7 +232,7 @@ def _small_build(tmp_path, student):
     nb.cells = SMALL_NOTEBOOK
     nbformat.write(nb, folder / "07_small.ipynb")
     index = site.build_site(tmp_path / ("student" if student else "site"), student=student,
-                            notebooks_dir=folder, readme=tmp_path / "no-readme.md")
+                            notebooks_dir=folder)
     return index, (index.parent / "07_small.html").read_text(encoding="utf-8")
 
 
@@ -254,10 +260,73 @@ def test_small_build_instructor_site(tmp_path):
     assert not re.search(r"<details[^>]*\sopen", page)
     # section numbers are the notebook's own: no second numbering added
     assert re.search(r"<h2>7\.1 First section", page)
+    # no setup cell, placeholder or build-machine output; the notebook to download, stored clean
+    assert "OWNER/NAME" not in page and "BUILD-MACHINE-VERSIONS" not in page
+    assert "Run online" not in index.read_text(encoding="utf-8")     # no repository address yet
+    link = re.search(r'<a[^>]*href="(_downloads/[^"]*07_small\.ipynb)"', page)
+    assert link, "no download link to the chapter's notebook"
+    downloaded = nbformat.read(out / link.group(1), as_version=4)
+    assert not any(c.get("outputs") for c in downloaded.cells if c.cell_type == "code")
 
 
 def test_small_build_student_site_has_no_solutions(tmp_path):
     index, page = _small_build(tmp_path, student=True)
+    link = re.search(r'<a[^>]*href="(_downloads/[^"]*07_small\.ipynb)"', page)
+    downloaded = (index.parent / link.group(1)).read_text(encoding="utf-8")
+    assert "SOLUTION" not in downloaded and "answer = None" in downloaded   # the student edition
     assert "student edition" in index.read_text(encoding="utf-8")
     assert "answer = None" in _text(page)
     assert "SOLUTION" not in _text(page) and "Show solution" not in page
+
+
+@pytest.mark.parametrize("repository, links", [
+    (None, []), ("https://github.com/OWNER", []), ("https://gitlab.com/a/b", []),
+    ("https://github.com/uni-x/control-course", ["https://mybinder.org/v2/gh/uni-x/control-course/HEAD",
+                                                 "https://colab.research.google.com/github/uni-x/control-course",
+                                                 "https://github.com/uni-x/control-course"]),
+])
+def test_run_online_links_appear_only_with_a_repository_address(repository, links):
+    text = site.run_online(repository)
+    assert all(link in text for link in links) and (bool(text) == bool(links))
+
+
+#: put before the build's own Python processes (the build, the kernels, Sphinx): every connection
+#: to a host other than this machine is refused, and noted in the file named by $CK_NETWORK_LOG
+_NO_NETWORK = """
+import os, socket
+_connect = socket.socket.connect
+
+def _refuse_outside(self, address, *args):
+    host = address[0] if isinstance(address, tuple) else ""
+    if self.family in (socket.AF_INET, socket.AF_INET6) and not (
+            host.startswith("127.") or host in ("localhost", "::1")):
+        with open(os.environ["CK_NETWORK_LOG"], "a") as log:
+            log.write(f"{address}\\n")
+        raise OSError(f"the network is refused in this test: {address}")
+    return _connect(self, address, *args)
+
+socket.socket.connect = _refuse_outside
+"""
+
+
+def test_the_site_builds_with_every_outside_connection_refused(tmp_path):
+    if site.missing_site_tools():
+        pytest.skip("the site extra is not installed")
+    guard = tmp_path / "guard"
+    guard.mkdir()
+    (guard / "sitecustomize.py").write_text(_NO_NETWORK, encoding="utf-8")
+    folder = tmp_path / "nb"
+    folder.mkdir()
+    nb = nbformat.v4.new_notebook()
+    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nb.cells = SMALL_NOTEBOOK + [_code("import socket\ntry:\n    socket.create_connection(('192.0.2.1', 80), 1)\n"
+                                       "except OSError as e:\n    print('refused:', e)")]
+    nbformat.write(nb, folder / "07_small.ipynb")
+    log = tmp_path / "network.log"
+    root = str(Path(site.__file__).resolve().parents[2])
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(guard), root]), CK_NETWORK_LOG=str(log))
+    result = subprocess.run([sys.executable, "-m", "coursekit", "site", "--out", str(tmp_path / "out"),
+                             "--notebooks", str(folder)], env=env, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-3000:]
+    # the probe cell's own attempt is the only one: the guard works, and the build asked for nothing
+    assert log.read_text().splitlines() == ["('192.0.2.1', 80)"]

@@ -32,7 +32,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from .cells import is_solution
+from .cells import ENVIRONMENT, INSTALL, is_solution, role
 from .chapters import chapter_notebooks
 
 __all__ = [
@@ -331,14 +331,14 @@ html_copy_source = False
 
 
 def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: int = 600,
-               readme=None, verbose: bool = False) -> Path:
+               verbose: bool = False) -> Path:
     """Build the course website into `out_dir` and return the path of its ``index.html``.
 
     `student=True` builds it from the student edition (no solutions). `notebooks_dir` defaults to
     the repository's ``notebooks/``; `timeout` is the limit in seconds for one notebook cell;
-    `readme` (default: the repository's README.md, if present) supplies an optional "Run online"
-    section for the landing page; `verbose=True` prints each step to stderr. `out_dir` is
-    replaced by the new site.
+    the landing page links to Binder, Colab and the repository once the notebooks' install cell
+    holds the repository's address (``python -m coursekit colab``); `verbose=True` prints each
+    step to stderr. `out_dir` is replaced by the new site.
     """
     if not isinstance(student, bool):
         raise TypeError(f"student must be True or False, got {student!r}")
@@ -357,7 +357,9 @@ def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: i
         src = Path(tmp) / "src"
         src.mkdir()
         chapters = _prepare_all(sources, src, student=student, timeout=timeout, verbose=verbose)
-        _write_sources(src, chapters, student=student, readme=readme)
+        import nbformat
+        _write_sources(src, chapters, student=student,
+                       repository=repository_of(nbformat.read(sources[0], as_version=4)))
         html = Path(tmp) / "html"
         _say(verbose, "building the HTML pages with Sphinx")
         _run_sphinx(src, html)
@@ -407,6 +409,9 @@ def _prepare(path: Path, src: Path, *, student: bool, timeout: int) -> dict:
     if student:
         from .release import student_edition   # the one definition of the student edition
         nb = student_edition(nb)
+    (src / "downloads").mkdir(exist_ok=True)
+    nbformat.write(nb, src / "downloads" / path.name)       # the notebook as a reader downloads it
+    nb = for_the_site(nb, path.name, repository=repository_of(nb))
     _execute(nb, cwd=path.parent, timeout=timeout, name=path.name)
     strip_widget_views(nb)
     fold_solution_code(nb)
@@ -415,6 +420,25 @@ def _prepare(path: Path, src: Path, *, student: bool, timeout: int) -> dict:
             cell.source = erratum_admonitions(_source(cell))
     nbformat.write(nb, src / path.name)
     return chapter_entry(nb, path.stem)
+
+
+def repository_of(nb) -> str | None:
+    """The course repository's https address, as the install cell of `nb` holds it (None until
+    ``python -m coursekit colab`` has written one)."""
+    from .colab import cell_repository
+    return next((cell_repository(_source(c)) for c in nb.cells if role(c) == INSTALL), None)
+
+
+def for_the_site(nb, name: str, *, repository: str | None = None):
+    """`nb` as its page shows it: without the setup cells (the install cell and the environment
+    check, whose output is the build machine's), with a line to download the notebook under its
+    title (and to the repository, when its address is known)."""
+    import nbformat
+    nb.cells = [c for c in nb.cells if role(c) not in (INSTALL, ENVIRONMENT)]
+    where = f" · [the course repository]({repository})" if repository else ""
+    nb.cells.insert(1, nbformat.v4.new_markdown_cell(
+        f"Download this chapter as a notebook: {{download}}`{name} <downloads/{name}>`{where}"))
+    return nb
 
 
 def _execute(nb, *, cwd: Path, timeout: int, name: str) -> None:
@@ -428,22 +452,26 @@ def _execute(nb, *, cwd: Path, timeout: int, name: str) -> None:
         raise RuntimeError(f"notebook {name} failed while building the site:\n{error}") from None
 
 
-def _write_sources(src: Path, chapters: list[dict], *, student: bool, readme) -> None:
+def _write_sources(src: Path, chapters: list[dict], *, student: bool, repository: str | None) -> None:
     title = "Course notebooks (student edition)" if student else "Course notebooks"
-    readme_path = REPO_ROOT / "README.md" if readme is None else Path(readme)
-    online = _readme_section(readme_path, "Run online") if readme_path.is_file() else ""
-    (src / "index.md").write_text(landing_page(chapters, student=student, run_online=online),
+    (src / "index.md").write_text(landing_page(chapters, student=student, run_online=run_online(repository)),
                                   encoding="utf-8")
     (src / "conf.py").write_text(sphinx_conf(title=title), encoding="utf-8")
     (src / "_static").mkdir()
     (src / "_static" / "coursekit.css").write_text(CSS, encoding="utf-8")
 
 
-def _readme_section(path: Path, heading: str) -> str:
-    """The body of the README section whose ``##`` heading starts with `heading` ('' if none)."""
-    text = path.read_text(encoding="utf-8")
-    match = re.search(rf"^##\s+{re.escape(heading)}[^\n]*\n(.*?)(?=^##\s|\Z)", text, re.MULTILINE | re.DOTALL)
-    return match.group(1).strip() if match else ""
+def run_online(repository: str | None) -> str:
+    """The landing page's "Run online" text for the course repository at `repository` (an https
+    address on GitHub), or '' when there is none: no link is published before it can work."""
+    match = re.fullmatch(r"https://github\.com/([\w.-]+/[\w.-]+?)(?:\.git)?/?", repository or "")
+    if match is None:
+        return ""
+    path = match.group(1)
+    return (f"Open a chapter on [Binder](https://mybinder.org/v2/gh/{path}/HEAD?urlpath=lab/tree/notebooks) "
+            f"(a temporary JupyterLab; nothing is saved) or on Google Colab "
+            f"(https://colab.research.google.com/github/{path}/blob/main/notebooks/, then the chapter's file "
+            f"name), or get everything from [the course repository]({repository}).")
 
 
 def _run_sphinx(src: Path, html: Path) -> None:
