@@ -25,7 +25,7 @@ _MODULES = (
     # chapter 4: observability and observers
     "observability", "observers", "kalman", "kalman_discrete",
     # course tools: figure style and layout
-    "style",
+    "style", "describe",
     # course tools: environment check (exercises stay the subpackage coursekit.exercises)
     "environment_check", "diagnostics",
 )

@@ -55,7 +55,8 @@ def test_mimebundle_holds_the_widget_view_and_a_static_png():
     assert bundle["application/vnd.jupyter.widget-view+json"]["model_id"] == exp.widget.model_id
     png = base64.b64decode(bundle["image/png"])
     assert png.startswith(PNG_MAGIC)
-    assert bundle["text/plain"] == "Demo. Settings: a = 1."
+    assert bundle["text/plain"].startswith("Demo. Settings: a = 1. The plot (demo) shows y [m] against t [s]")
+    assert "y: starts at 1," in bundle["text/plain"]          # described from its data
 
 
 def test_moving_a_slider_refreshes_the_png_and_the_image_widget():
@@ -160,7 +161,7 @@ def test_the_readout_shows_the_numbers_and_joins_the_text_alternative():
     exp = _readout_explorer()
     widget = exp.widget
     assert exp.text == "peak 1 m\nsecond line"
-    assert exp.alt == "Demo. Settings: a = 1. peak 1 m\nsecond line"
+    assert exp.alt == "Demo. Settings: a = 1. peak 1 m; second line"
     readout = widget.children[2]
     assert "peak 1 m<br>second line" in readout.value
     assert widget.children[-1].alt == exp.alt

@@ -212,6 +212,8 @@ SMALL_NOTEBOOK = [
           f"display({{'image/png': '{PNG}', 'text/plain': 'explorer (static figure)',\n"
           "         'application/vnd.jupyter.' + 'widget-view+json':\n"
           "             {'model_id': 'm1', 'version_major': 2, 'version_minor': 0}}, raw=True)"),
+    _code("%matplotlib inline\nimport matplotlib.pyplot as plt\n"
+          "plt.plot([0, 1, 2], [0, 3, 1], label='bump'); plt.xlabel('time t [s]'); plt.legend(); plt.show()"),
     _markdown("### Exercise 7.1: one number"),
     _code("display({'text/markdown': '`n` $= 42$'}, raw=True)   # exercise data are typeset this way"),
     _code("answer = None"),
@@ -260,6 +262,10 @@ def test_small_build_instructor_site(tmp_path):
     assert not re.search(r"<details[^>]*\sopen", page)
     # section numbers are the notebook's own: no second numbering added
     assert re.search(r"<h2>7\.1 First section", page)
+    # every image described: the figure from its data, the explorer by its text
+    alts = re.findall(r'<img[^>]*alt="([^"]*)"', page)
+    assert any("bump: starts at 0, highest 3 at time t [s] = 1" in html.unescape(a) for a in alts), alts
+    assert "explorer (static figure)" in [html.unescape(a) for a in alts] and not any("_images/" in a for a in alts)
     # no setup cell, placeholder or build-machine output; the notebook to download, stored clean
     assert "OWNER/NAME" not in page and "BUILD-MACHINE-VERSIONS" not in page
     assert "Run online" not in index.read_text(encoding="utf-8")     # no repository address yet

@@ -27,6 +27,7 @@ from typing import Any, Callable
 import numpy as np
 
 from .._validation import as_scalar
+from ..describe import describe_figure
 from ._frames import FrameRenderer
 
 __all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale"]
@@ -52,8 +53,7 @@ def _range(value, min, max, step, description):
 
 
 def _style():
-    import ipywidgets as widgets
-    return dict(style={"description_width": "initial"}, layout=widgets.Layout(width="auto"))
+    return dict(style={"description_width": "initial"}, layout={"width": "auto"})
 
 
 def slider(value: float, min: float, max: float, step: float, description: str, *,
@@ -238,7 +238,7 @@ class Explorer:
         """The figure's text alternative: the title, the settings and the readout."""
         settings = ", ".join(f"{k} = {v:g}" if isinstance(v, (int, float)) else f"{k} = {v}"
                              for k, v in self.params.items())
-        return f"{self.title}. Settings: {settings}." + (f" {self.text}" if self.text else "")
+        return f"{self.title}. Settings: {settings}." + (f" {self.text}".replace("\n", "; ") if self.text else "")
 
     def _apply(self, params: dict) -> None:
         result = self._compute(**params)
@@ -326,8 +326,8 @@ class Explorer:
     def _repr_mimebundle_(self, include=None, exclude=None):
         bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude)
         bundle["image/png"] = base64.b64encode(self.static_png()).decode("ascii")
-        bundle["text/plain"] = self.alt
+        bundle["text/plain"] = repr(self)
         return bundle
 
-    def __repr__(self) -> str:
-        return f"<Explorer {self.title!r}: {', '.join(self.controls)}>"
+    def __repr__(self) -> str:   # the text a page without a kernel shows for the figure: its alt and data
+        return f"{self.alt} {describe_figure(self.fig)}"

@@ -44,9 +44,23 @@ __all__ = [
     "landing_page",
     "sphinx_conf",
     "missing_site_tools",
+    "repository_of",
+    "for_the_site",
+    "run_online",
+    "describe_images",
 ]
 
 WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
+
+#: the theme's search button says "Search" to a screen reader but shows "Search ... Ctrl+K": its
+#: accessible name becomes the text it shows (WCAG 2.5.3, label in name)
+JS = """document.addEventListener("DOMContentLoaded", () => {
+  for (const button of document.querySelectorAll("button.search-button__button")) {
+    const shown = button.textContent.replace(/\\s+/g, " ").trim();
+    if (shown) button.setAttribute("aria-label", shown);
+  }
+});
+"""
 SITE_TOOLS = {"sphinx": "sphinx", "myst_nb": "myst-nb", "sphinx_book_theme": "sphinx-book-theme",
               "sphinx-mathjax-offline": "sphinx-mathjax-offline", "nbclient": "nbclient",
               "nbformat": "nbformat", "ipykernel": "ipykernel"}
@@ -313,6 +327,7 @@ html_theme = "sphinx_book_theme"
 html_title = {title!r}
 html_static_path = ["_static"]
 html_css_files = ["coursekit.css"]
+html_js_files = ["coursekit.js"]
 html_theme_options = {{
     "home_page_in_toc": True,
     "show_toc_level": 2,
@@ -412,7 +427,10 @@ def _prepare(path: Path, src: Path, *, student: bool, timeout: int) -> dict:
     (src / "downloads").mkdir(exist_ok=True)
     nbformat.write(nb, src / "downloads" / path.name)       # the notebook as a reader downloads it
     nb = for_the_site(nb, path.name, repository=repository_of(nb))
+    nb.cells.insert(0, nbformat.v4.new_code_cell(DESCRIBE_FIGURES))
     _execute(nb, cwd=path.parent, timeout=timeout, name=path.name)
+    nb.cells.pop(0)
+    describe_images(nb)
     strip_widget_views(nb)
     fold_solution_code(nb)
     for cell in nb.cells:
@@ -441,6 +459,44 @@ def for_the_site(nb, name: str, *, repository: str | None = None):
     return nb
 
 
+#: the media type under which the kernel adds each figure's description to its display data
+ALT = "text/x-coursekit-alt"
+
+#: run first in each notebook the site executes: every matplotlib figure displayed carries its
+#: description (`coursekit.describe_figure`), from a display formatter that asks each object for
+#: it by a method name (the inline backend resets the formatters' figure types when switched on)
+DESCRIBE_FIGURES = f"""\
+from IPython.core.formatters import BaseFormatter as _Base
+from traitlets import ObjectName as _Name
+import coursekit as _ck
+import matplotlib.figure as _figure
+class _Alt(_Base):
+    format_type = {ALT!r}
+    print_method = _Name("_coursekit_alt_")
+_figure.Figure._coursekit_alt_ = _ck.describe_figure
+_shell = get_ipython()
+_shell.display_formatter.formatters[{ALT!r}] = _Alt(parent=_shell.display_formatter)
+_shell.display_formatter.active_types = [*_shell.display_formatter.active_types, {ALT!r}]
+"""
+
+
+def describe_images(nb):
+    """Give each code cell's images of `nb` their descriptions as ``alt`` (in place; returned):
+    a figure's from `ALT`, an explorer's from its text (title, settings, readout and data)."""
+    for cell in nb.cells:
+        texts = []
+        for output in cell.get("outputs", []):
+            data = output.get("data", {})
+            if ALT in data:
+                texts.append(_source({"source": data.pop(ALT)}))
+            elif "image/png" in data and WIDGET_VIEW in data:
+                texts.append(_source({"source": data.get("text/plain", "")}))
+        if texts:
+            mystnb = cell.metadata.setdefault("mystnb", {})
+            mystnb["image"] = {**mystnb.get("image", {}), "alt": " ".join(texts)}
+    return nb
+
+
 def _execute(nb, *, cwd: Path, timeout: int, name: str) -> None:
     from nbclient import NotebookClient
     from nbclient.exceptions import CellExecutionError
@@ -459,6 +515,7 @@ def _write_sources(src: Path, chapters: list[dict], *, student: bool, repository
     (src / "conf.py").write_text(sphinx_conf(title=title), encoding="utf-8")
     (src / "_static").mkdir()
     (src / "_static" / "coursekit.css").write_text(CSS, encoding="utf-8")
+    (src / "_static" / "coursekit.js").write_text(JS, encoding="utf-8")
 
 
 def run_online(repository: str | None) -> str:
