@@ -66,12 +66,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import as_matrix, as_square, as_system
-from .diagnostics import warn_accuracy
-from .systems import StateSpace
+from ._validation import as_matrix, as_square
+from .diagnostics import NotControllableError, warn_accuracy
+from .systems import StateSpace, as_system
 
 __all__ = [
-    "NotControllableError",
     "ctrb",
     "ctrb_singular_values",
     "is_controllable",
@@ -85,10 +84,6 @@ _EPS = np.finfo(float).eps
 _MARGINAL = 100.0
 # the tolerance grows with 1 / (smallest coupling so far), up to this factor (module docstring)
 _AMPLIFICATION_CAP = 1e3
-
-
-class NotControllableError(ValueError):
-    """Raised when an algorithm needs a controllable pair (A, B) and it is not."""
 
 
 def _pair(A, B):

@@ -22,9 +22,9 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_square, as_system, as_vector
+from ._validation import as_matrix, as_scalar, as_square, as_vector
 from .diagnostics import UserFunctionError
-from .systems import NonlinearSystem, StateSpace, _checked_call, _float_array
+from .systems import NonlinearSystem, StateSpace, as_system, _checked_call, _float_array
 
 __all__ = [
     "StateFeedback",

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_dt, as_integer, as_matrix, as_scalar, as_system, as_vector, foreign_library
-from .diagnostics import UserFunctionError, call_user
+from ._validation import as_dt, as_integer, as_matrix, as_scalar, as_vector, call_user, foreign_library
+from .diagnostics import UserFunctionError
 from .linearization import _function_name, _input_size_explained, _sympy_column
-from .systems import NonlinearSystem, StateSpace, _raw_field
+from .systems import NonlinearSystem, StateSpace, as_system, _raw_field
 
 __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
 

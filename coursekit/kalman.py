@@ -51,12 +51,13 @@ from typing import Callable
 
 import numpy as np
 
-from .diagnostics import UserFunctionError, call_user_fast, warn_accuracy
-from ._validation import as_dt, as_scalar, as_series, as_square, as_system, as_time_grid, as_vector, is_uniform
+from ._validation import (as_dt, as_scalar, as_series, as_square, as_time_grid, as_vector, call_user_fast,
+                          is_uniform)
+from .diagnostics import UserFunctionError, warn_accuracy
 from .linearization import _jacobian, _perturbed, _quotients
 from .observability import _obs_pair
 from .simulation import SimulationResult, _agrees_column_by_column, lti_step_matrices
-from .systems import NonlinearSystem, StateSpace, _raw_field, _raw_output
+from .systems import StateSpace, as_system, _raw_field, _raw_output
 
 __all__ = [
     "kalman_gain",
@@ -719,7 +720,7 @@ def _at(t: float) -> str:
 
 def _user(fun, name: str, *, batch: bool = False):
     """(x, u, t) -> fun(x, u) as a finite float array, or a `UserFunctionError` naming
-    `name` and the time t (`diagnostics.call_user_fast`: the EKF calls f and h four times
+    `name` and the time t (`_validation.call_user_fast`: the EKF calls f and h four times
     per RK4 step, so the common case costs one finiteness check)."""
     extra = " (on x̂ and its central-difference neighbours, as columns)" if batch else ""
 

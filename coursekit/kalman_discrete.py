@@ -27,9 +27,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_series, as_system
+from ._validation import as_series
 from .kalman import KalmanResult, _covariance, _initial_estimate
-from .systems import StateSpace
+from .systems import StateSpace, as_system
 
 __all__ = ["discrete_kalman_filter"]
 

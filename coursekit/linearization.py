@@ -22,9 +22,9 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import _is_complex, as_dt, as_flag, as_scalar, as_system, as_vector, foreign_library
-from .diagnostics import call_user, warn_accuracy
-from .systems import NonlinearSystem, StateSpace, _raw_field
+from ._validation import _is_complex, as_dt, as_flag, as_scalar, as_vector, call_user, foreign_library
+from .diagnostics import warn_accuracy
+from .systems import NonlinearSystem, StateSpace, as_system, _raw_field
 
 __all__ = ["linearize", "symbolic_jacobian", "linearize_symbolic"]
 

@@ -21,12 +21,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import as_matrix, as_poles, as_square
+from .diagnostics import NotObservableError
 from .controllability import (_canonical_transform, _check_tol, _controllability, _ctrb,
                               _marginal_note, _Staircase)
 from .placement import _gain, _PoleMatch, _require_finite, _warn_if_missed, check_size, poly_from_roots
 
 __all__ = [
-    "NotObservableError",
     "obsv",
     "obsv_singular_values",
     "is_observable",
@@ -35,10 +35,6 @@ __all__ = [
     "place_observer_details",
     "ObserverDetails",
 ]
-
-
-class NotObservableError(ValueError):
-    """Raised when an algorithm needs an observable pair (A, C) and it is not."""
 
 
 def _obs_pair(A, C):

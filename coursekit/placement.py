@@ -16,8 +16,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import as_poles
-from .controllability import NotControllableError, _pair, _rank, ccf_transform, require_controllable
-from .diagnostics import warn_accuracy
+from .controllability import _pair, _rank, ccf_transform, require_controllable
+from .diagnostics import NotControllableError, warn_accuracy
 
 __all__ = ["place", "place_details", "PlacementDetails", "poly_from_roots"]
 

@@ -33,12 +33,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import (as_matrix, as_scalar, as_series, as_square, as_system, as_time_grid, as_vector,
+from ._validation import (as_matrix, as_scalar, as_series, as_square, as_time_grid, as_vector, call_user,
                           is_uniform)
-from .diagnostics import UserFunctionError, call_user
-from .systems import NonlinearSystem, StateSpace, _checked_call, _raw_field
+from .diagnostics import SimulationError, UserFunctionError
+from .systems import NonlinearSystem, StateSpace, as_system, _checked_call, _raw_field
 
-__all__ = ["simulate", "simulate_batch", "SimulationResult", "SimulationError", "lti_step_matrices"]
+__all__ = ["simulate", "simulate_batch", "SimulationResult", "lti_step_matrices"]
 
 # the method names scipy.integrate.solve_ivp accepts
 _METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
@@ -47,17 +47,6 @@ _RTOL_MIN = 100 * np.finfo(float).eps
 # beyond sqrt(largest float) ~ 1.3e154 the square of a state entry overflows: any model with
 # a quadratic term returns inf there, which is the state's growth, not a bug in the model
 _HUGE = float(np.sqrt(np.finfo(float).max))
-
-
-class SimulationError(ValueError, RuntimeError):
-    """The simulation cannot reach the end of the time grid.
-
-    Raised when the state overflows the float range (about 1.8e308: an
-    unstable system simulated for too long, or a solution with a finite
-    escape time) and when the ODE solver gives up. The message says at
-    which time, why, and what to try. It is both a ValueError and a
-    RuntimeError, so either catches it.
-    """
 
 
 @dataclass(repr=False)

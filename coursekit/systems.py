@@ -9,12 +9,14 @@ them alike.
 
 from __future__ import annotations
 
+import sys as _sys
 from typing import Callable
 
 import numpy as np
 
-from ._validation import as_dt, as_matrix, as_scalar, as_square, check_function_output
-from .diagnostics import UserFunctionError, call_user, call_user_fast
+from ._validation import (BRIDGES, as_dt, as_matrix, as_scalar, as_square, call_user, call_user_fast,
+                          check_function_output, foreign_library, type_name)
+from .diagnostics import UserFunctionError
 
 __all__ = ["StateSpace", "NonlinearSystem"]
 
@@ -229,7 +231,7 @@ class StateSpace:
     def from_control(cls, sys) -> "StateSpace":
         """The python-control ``StateSpace`` `sys` as a coursekit StateSpace (dt=0 -> continuous)."""
         from .bridges import from_control
-        return from_control(sys)
+        return from_control(sys, cls)
 
     def to_control(self):
         """This system as a python-control ``StateSpace`` (continuous -> dt=0; needs `pip install control`)."""
@@ -240,7 +242,7 @@ class StateSpace:
     def from_scipy(cls, sys) -> "StateSpace":
         """The ``scipy.signal.StateSpace`` `sys` (continuous or discrete) as a coursekit StateSpace."""
         from .bridges import from_scipy
-        return from_scipy(sys)
+        return from_scipy(sys, cls)
 
     def to_scipy(self):
         """This system as a ``scipy.signal.StateSpace`` (continuous: dt=None; discrete: its dt)."""
@@ -335,3 +337,62 @@ class NonlinearSystem:
         extra = ", ".join(f"{k}={v:g}" if isinstance(v, (int, float)) else f"{k}={v!r}"
                           for k, v in self.params.items())
         return f"NonlinearSystem{title}: n={self.n}, m={self.m} ({kind})" + (f"; {extra}" if extra else "")
+
+
+_KINDS = {"any": "StateSpace or NonlinearSystem", "linear": "StateSpace", "nonlinear": "NonlinearSystem"}
+
+
+def _system_received(value) -> str:
+    """How a refused system argument is described: its time base, or its full type name."""
+    if isinstance(value, np.ndarray):
+        return f"a numpy array of shape {value.shape}"
+    if hasattr(value, "is_discrete") and type(value).__module__ == "coursekit.systems":
+        base, period = ("discrete", f" (dt={value.dt:g})") if value.is_discrete else ("continuous", "")
+        return f"a {base}-time {type(value).__name__}{period}"
+    return type_name(value)
+
+
+def as_system(value, name: str = "sys", *, kind: str = "any", time: str = "", hint: str = ""):
+    """Return `value` as a coursekit system, converting python-control and scipy.signal ones.
+
+    `kind` is "any" (StateSpace or NonlinearSystem), "linear" (StateSpace) or
+    "nonlinear"; `time` is "", "continuous" or "discrete". A ``control.StateSpace``
+    or ``scipy.signal.StateSpace`` (also ``scipy.signal.lti(A, B, C, D)``) goes through
+    the bridges `StateSpace.from_control` / `from_scipy` (the same matrices (1.24) and
+    time base); one whose time base is unspecified (``dt=True``, or python-control's
+    ``dt=None``) is refused, because reading it as dt = 1 or as continuous is the user's
+    choice, and so is choosing the realization of a transfer function: both messages
+    name the bridge. Anything else raises ValueError naming `name`, the wanted kind and
+    the full type name of what was received, followed by `hint`.
+    """
+    library = foreign_library(value)
+    if library is not None:
+        value = _from_foreign(value, name, library)
+    wanted = (StateSpace, NonlinearSystem) if kind == "any" else \
+        StateSpace if kind == "linear" else NonlinearSystem
+    right_time = not time or isinstance(value, (StateSpace, NonlinearSystem)) and \
+        value.is_discrete == (time == "discrete")
+    if not isinstance(value, wanted) or not right_time:
+        base = f"{time}-time " if time else ""
+        raise ValueError(f"{name} must be a {base}{_KINDS[kind]}: received {_system_received(value)}"
+                         + (f"; {hint}" if hint else "."))
+    return value
+
+
+def _from_foreign(value, name: str, library: str):
+    """The coursekit StateSpace of a python-control / scipy.signal state-space object (bridges)."""
+    from .bridges import realization_hint
+    module = _sys.modules["control" if library == "python-control" else "scipy.signal"]
+    bridge = BRIDGES[library]
+    if not isinstance(value, module.StateSpace):
+        raise ValueError(f"{name} must be a state-space system: received {type_name(value)}. "
+                         f"{realization_hint(value)} Then convert it with {bridge}(sys).")
+    dt = value.dt
+    if dt is True or (dt is None and library == "python-control"):
+        raise ValueError(
+            f"{name} is a {library} system whose time base is unspecified (dt={dt!r}): "
+            f"convert it with {bridge}(sys), which reads dt=True as a period of 1 and "
+            "python-control's dt=None as continuous time, or build it with dt=0 (continuous) "
+            "or the sampling period."
+        )
+    return getattr(StateSpace, bridge.split(".")[1])(value)

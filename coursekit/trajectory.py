@@ -23,9 +23,9 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_integer, as_scalar, as_series, as_time_grid, as_vector, time_grid
+from ._validation import as_integer, as_scalar, as_series, as_time_grid, as_vector, call_user, time_grid
 from .controllability import _pair, ccf_transform, charpoly
-from .diagnostics import call_user, warn_accuracy
+from .diagnostics import warn_accuracy
 
 __all__ = ["PolyTrajectory", "poly_trajectory", "feedforward", "OpenLoopPlan", "open_loop_control",
            "plot_plan"]

@@ -704,17 +704,12 @@ bad("new_figure", "figsize negative", lambda: ck.new_figure(1, 1, figsize=(-4, 3
 ok("fit_margins", "good", lambda: ck.fit_margins(ck.new_figure()[0]))
 bad("fit_margins", "fig None", lambda: ck.fit_margins(None), "fig")
 bad("fit_margins", "fig an Axes", lambda: ck.fit_margins(ck.new_figure()[1]), "fig")
-ok("detect_host", "good", ck.detect_host)
-bad("detect_host", "called with an argument", lambda: ck.detect_host("colab"), "detect_host")
 ok("check_environment", "good", lambda: ck.check_environment(show=False))
 bad("check_environment", "show text", lambda: ck.check_environment(show="no"), "show")
 ok("EnvironmentReport", "ok", lambda: ck.check_environment(show=False).ok)
 ok("find_widget_frontend", "good", lambda: ck.find_widget_frontend([]))
 bad("find_widget_frontend", "dirs a string", lambda: ck.find_widget_frontend("/nonexistent"), "dirs")
 bad("find_widget_frontend", "dirs a number", lambda: ck.find_widget_frontend(3), "dirs")
-ok("call_user", "good", lambda: ck.call_user(lambda x: x, (np.ones(2),), "g"))
-bad("call_user", "user function raises", lambda: ck.call_user(lambda x: 1 / 0, (1.0,), "g"), "g")
-bad("call_user", "func not callable", lambda: ck.call_user(3.0, (1.0,), "g"), "g")
 
 # ---------------------------------------------------------------------------
 # models
