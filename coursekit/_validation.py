@@ -26,6 +26,7 @@ __all__ = [
     "as_time_grid",
     "is_uniform",
     "as_poles",
+    "as_covariance",
     "as_integer",
     "as_dt",
     "as_text",
@@ -336,6 +337,34 @@ def is_uniform(t: np.ndarray, rtol: float = 1e-9) -> bool:
     """True when the grid `t` has (to rounding) a constant step."""
     steps = np.diff(t)
     return bool(np.all(np.abs(steps - steps[0]) <= rtol * max(abs(steps[0]), np.abs(t).max())))
+
+
+def as_covariance(value, name: str, size: int, *, definite: bool, why: str = "") -> np.ndarray:
+    """A symmetric (size x size) matrix, positive definite or semidefinite (Q, R, P0 of (4.88)).
+
+    `why` says where `size` comes from ("one row and column per state, since A is 2x2").
+    """
+    M = as_square(value, name)
+    if M.shape[0] != size:
+        reason = f" ({why})" if why else ""
+        raise ValueError(f"{name} has the wrong size: received shape {M.shape}, expected "
+                         f"({size}, {size}){reason}.")
+    if not np.allclose(M, M.T, rtol=1e-10, atol=1e-12 * max(1.0, np.abs(M).max())):
+        raise ValueError(f"{name} must be symmetric: received {M.tolist()!r}; use (M + M.T) / 2.")
+    M = (M + M.T) / 2
+    low = float(np.linalg.eigvalsh(M).min())
+    scale = max(1.0, float(np.abs(M).max()))
+    if definite and low <= 1e-12 * scale:
+        raise ValueError(
+            f"{name} must be positive definite: its smallest eigenvalue is {low:.3g}; "
+            f"expected every eigenvalue > 0 (e.g. a diagonal matrix with positive entries)."
+        )
+    if not definite and low < -1e-10 * scale:
+        raise ValueError(
+            f"{name} must be positive semidefinite: its smallest eigenvalue is {low:.3g} < 0; "
+            "expected a covariance-like matrix such as np.diag([q1, q2])."
+        )
+    return M
 
 
 def as_poles(poles, name: str = "poles", *, count: int) -> np.ndarray:

@@ -675,6 +675,11 @@ matrix_cases("white_noise", "t", lambda t: ck.white_noise(t, 1.0, seed=0), T11, 
 scalar_cases("white_noise", "intensity", lambda q: ck.white_noise(T11, q, seed=0), 1.0)
 bad("white_noise", "intensity negative", lambda: ck.white_noise(T11, -1.0, seed=0), "intensity")
 bad("white_noise", "seed text", lambda: ck.white_noise(T11, 1.0, seed="a"), "seed")
+matrix_cases("van_loan", "A", lambda A: ck.van_loan(A, np.eye(2), 0.1), A2)
+matrix_cases("van_loan", "Q", lambda Q: ck.van_loan(A2, Q, 0.1), np.eye(2))
+bad("van_loan", "Q not symmetric", lambda: ck.van_loan(A2, [[1.0, 1.0], [0.0, 1.0]], 0.1), "Q")
+bad("van_loan", "Q negative", lambda: ck.van_loan(A2, -np.eye(2), 0.1), "Q")
+scalar_cases("van_loan", "dt", lambda dt: ck.van_loan(A2, np.eye(2), dt), 0.1, positive=True)
 def _swn(**kw):
     args = dict(u=np.zeros((11, 1)), x0=np.zeros(2), Q=Q2, R=R1, seed=0)
     args.update(kw)
