@@ -35,6 +35,10 @@ __all__ = [
     "check_function_output",
     "call_user",
     "call_user_fast",
+    "checked_call",
+    "float_array",
+    "is_complex",
+    "is_text",
     "foreign_library",
     "type_name",
     "BRIDGES",
@@ -50,7 +54,7 @@ def _describe(value) -> str:
     return f"{type(value).__name__} {value!r}"
 
 
-def _is_complex(value) -> bool:
+def is_complex(value) -> bool:
     """True for complex numbers or arrays, even when their imaginary parts are zero.
 
     Covers Python and numpy complex scalars and arrays, lists of them, and
@@ -75,7 +79,11 @@ def _is_complex(value) -> bool:
     return False
 
 
-def _is_text(value) -> bool:
+# the old private name, still imported by coursekit.exercises._feedback
+_is_complex = is_complex
+
+
+def is_text(value) -> bool:
     """True for a string, or a list/array of strings ("1.0" is text, not a number)."""
     if isinstance(value, (str, bytes)):
         return True
@@ -130,12 +138,12 @@ def _to_float_array(value, name: str) -> np.ndarray:
     if value is None:
         raise ValueError(f"{name} is missing: received None, expected a number or an array.")
     _refuse_system_as_matrix(value, name)
-    if _is_text(value):
+    if is_text(value):
         raise ValueError(
             f"{name} must contain real numbers: received the text {value!r}; type the numbers "
             "themselves, e.g. 0.5 or [[0, 1], [-2, -3]], without quotes."
         )
-    if _is_complex(value):
+    if is_complex(value):
         raise ValueError(
             f"{name} must contain real numbers: received {_describe(value)} with complex "
             "entries; pass the real matrix (complex numbers are only accepted as poles)."
@@ -425,7 +433,7 @@ def call_user(func: Callable, args: tuple, name: str, *, where: str = "",
         ) from err
     if out is None:
         raise UserFunctionError(f"{name} returned None{place}; did the function forget to return?")
-    if _is_complex(out):
+    if is_complex(out):
         raise UserFunctionError(f"{name} returned complex numbers{place}; expected real numbers.")
     try:
         arr = np.asarray(out, dtype=float)
@@ -473,3 +481,33 @@ def check_function_output(func: Callable, args: tuple, name: str, *, size: int, 
     if arr.ndim > 1 and not (arr.ndim == 2 and 1 in arr.shape) or arr.size != size:
         raise ValueError(f"{name} returned shape {arr.shape}; expected {size} numbers ({what}).")
     return arr.ravel()
+
+
+def checked_call(func: Callable, args: tuple, name: str, *, size: int, what: str,
+                 where: str = "") -> np.ndarray:
+    """Call a user function once: an exception, None or NaN/inf is explained by
+    `call_user` (naming `name` and `where`), a wrong return shape by
+    `check_function_output`'s rule; returns the value as a flat float array."""
+    value = call_user(func, args, name, where=where)
+    try:
+        return check_function_output(lambda *_: value, args, name, size=size, what=what)
+    except ValueError as err:
+        if not where:
+            raise
+        raise UserFunctionError(f"{err} This happened {where}.") from None
+
+
+def float_array(value, name: str) -> np.ndarray:
+    """value as a float array; None, complex or non-numeric values raise ValueError naming `name`."""
+    if value is None:
+        raise ValueError(f"{name} is None: expected an array of real numbers.")
+    arr = np.asarray(value)
+    if arr.dtype.kind == "f":
+        return arr
+    if arr.dtype.kind == "c":
+        raise ValueError(f"{name} must contain real numbers: received complex entries.")
+    try:
+        return arr.astype(float, copy=False)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{name} must be an array of real numbers: received {type(value).__name__} "
+                         f"({err}).") from None

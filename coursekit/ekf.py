@@ -17,9 +17,9 @@ from ._filter_ode import checked_substeps, filter_setup, initial_estimate, recor
 from ._validation import call_user_fast
 from .diagnostics import UserFunctionError
 from .kalman_bucy import KalmanResult
-from .linearization import _jacobian, _perturbed, _quotients
-from .simulation import _agrees_column_by_column
-from .systems import as_system, _raw_field, _raw_output
+from .linearization import numerical_jacobian, perturbed_states, difference_quotients
+from .simulation import agrees_column_by_column
+from .systems import as_system, raw_field, raw_output
 
 __all__ = ["extended_kalman_filter"]
 
@@ -47,18 +47,18 @@ def _ekf_rhs(model, Q, R, m: int):
 
 def _accepts_batches(fun, x0: np.ndarray, u0: np.ndarray) -> bool:
     """True when fun(X, U), states and inputs as columns, agrees column by column with
-    fun(x, u) on single states (within 1e-12), checked on the states of `_perturbed(x0)`.
+    fun(x, u) on single states (within 1e-12), checked on the states of `perturbed_states(x0)`.
 
     The test of `simulation._check_batch`, but a function written for one state at a
     time (``float(x[0])``, ``if x[0] > 0``, ...) is an answer, not an error; so is a
     function that raises here (it is then called one state at a time, and an error it
     raises there is reported with its context).
     """
-    X, _ = _perturbed(x0)
+    X, _ = perturbed_states(x0)
     U = u0[:, None].repeat(X.shape[1], axis=1)
     try:
         batch = np.asarray(fun(X, U), dtype=float)
-        return _agrees_column_by_column(fun, X, U, batch)
+        return agrees_column_by_column(fun, X, U, batch)
     except Exception:                   # written for one state at a time
         return False
 
@@ -93,15 +93,15 @@ def _user_jacobian(fun, name: str, shape: tuple[int, int], what: str):
 
 def _batched_model(f, h, n: int):
     """(x, u, t) -> (f, h, ∂f/∂x, ∂h/∂x) at (x, u) from one call of f and one of h on the
-    batch of `_perturbed(x)`: x and its 2n central-difference neighbours as columns."""
+    batch of `perturbed_states(x)`: x and its 2n central-difference neighbours as columns."""
     cols = 2 * n + 1
     f, h = _user(f, "f", batch=True), _user(h, "h", batch=True)
 
     def model(x, u, t):
-        X, step = _perturbed(x)
+        X, step = perturbed_states(x)
         U = u[:, None].repeat(cols, axis=1)
         G = np.concatenate((f(X, U, t).reshape(-1, cols), h(X, U, t).reshape(-1, cols)))
-        J = _quotients(G, step)
+        J = difference_quotients(G, step)
         return G[:n, -1], G[n:, -1], J[:n], J[n:]
     return model
 
@@ -124,15 +124,15 @@ def _ekf_model(sys, p: int, dfdx, dhdx, x0, u0):
             raise ValueError(f"{name} must be a function (x, u) -> Jacobian, or None for "
                              f"numerical differences: received {type(fun).__name__}.")
     n = sys.n
-    f_raw, h_raw = _raw_field(sys), _raw_output(sys)   # wrapped once, by _user, with the time
+    f_raw, h_raw = raw_field(sys), raw_output(sys)   # wrapped once, by _user, with the time
     if dfdx is None and dhdx is None and _accepts_batches(f_raw, x0, u0) \
             and _accepts_batches(h_raw, x0, u0):
         return _batched_model(f_raw, h_raw, n)
     f, h = _user(f_raw, "f"), _user(h_raw, "h")
     jf = _user_jacobian(dfdx, "dfdx", (n, n), "∂f/∂x (4.92), n x n") if dfdx else \
-        (lambda x, v, t: _jacobian(lambda z: f(z, v, t), x, refine=False))
+        (lambda x, v, t: numerical_jacobian(lambda z: f(z, v, t), x, refine=False))
     jh = _user_jacobian(dhdx, "dhdx", (p, n), "∂h/∂x (4.93), p x n") if dhdx else \
-        (lambda x, v, t: _jacobian(lambda z: h(z, v, t), x, refine=False))
+        (lambda x, v, t: numerical_jacobian(lambda z: h(z, v, t), x, refine=False))
     return lambda x, v, t: (f(x, v, t), h(x, v, t), jf(x, v, t), jh(x, v, t))
 
 
@@ -161,9 +161,9 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
     sys = as_system(sys, kind="nonlinear", time="continuous", hint="for a StateSpace use kalman_bucy.")
     t, u, y = records(t, u, y, sys.m)
     x0 = initial_estimate(x0, sys.n)
-    _user(_raw_field(sys), "f")(x0, u[0], t[0])
+    _user(raw_field(sys), "f")(x0, u[0], t[0])
     sys.check(x0, u[0])
-    p_h = _user(_raw_output(sys), "h")(x0, u[0], t[0]).size
+    p_h = _user(raw_output(sys), "h")(x0, u[0], t[0]).size
     if p_h != y.shape[1]:
         raise ValueError(f"y has the wrong number of columns: received {y.shape[1]}, expected "
                          f"{p_h} (the number of outputs of sys.h).")

@@ -37,7 +37,7 @@ import numpy as np
 
 from ._validation import as_covariance, as_dt
 from .diagnostics import warn_accuracy
-from .observability import _obs_pair
+from .observability import as_obs_pair
 
 __all__ = ["kalman_gain"]
 
@@ -53,7 +53,7 @@ def _output_why(p: int) -> str:
 
 def _gain_inputs(A, C, Q, R):
     """Validate in the order the sizes come from: A (n), C (p rows), then Q (n x n), R (p x p)."""
-    A, C = _obs_pair(A, C)
+    A, C = as_obs_pair(A, C)
     n, p = A.shape[0], C.shape[0]
     Q = as_covariance(Q, "Q", n, definite=False, why=_state_why(n))
     R = as_covariance(R, "R", p, definite=True, why=_output_why(p))

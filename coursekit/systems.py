@@ -5,6 +5,11 @@
 `NonlinearSystem` holds the vector field f of (1.32) and the output map h
 of (1.33). Both expose `f(x, u)` and `h(x, u)` so that `simulate` treats
 them alike.
+
+Shared within coursekit (not in ``ck.*``): `as_system` (every public function
+that takes a system calls it: python-control and scipy.signal systems are
+converted through the bridges), and `raw_field` / `raw_output`, the model's own
+f and h for hot loops.
 """
 
 from __future__ import annotations
@@ -14,45 +19,14 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import (BRIDGES, as_dt, as_matrix, as_scalar, as_square, call_user, call_user_fast,
-                          check_function_output, foreign_library, type_name)
-from .diagnostics import UserFunctionError
+from ._validation import (BRIDGES, as_dt, as_matrix, as_scalar, as_square, call_user, call_user_fast, checked_call,
+                          float_array, foreign_library, type_name)
 
 __all__ = ["StateSpace", "NonlinearSystem"]
 
 
 def _check_dt(dt, name: str = "dt") -> float | None:
     return as_dt(dt, name)
-
-
-def _checked_call(func: Callable, args: tuple, name: str, *, size: int, what: str,
-                  where: str = "") -> np.ndarray:
-    """Call a user function once: an exception, None or NaN/inf is explained by
-    `call_user` (naming `name` and `where`), a wrong return shape by
-    `check_function_output`'s rule; returns the value as a flat float array."""
-    value = call_user(func, args, name, where=where)
-    try:
-        return check_function_output(lambda *_: value, args, name, size=size, what=what)
-    except ValueError as err:
-        if not where:
-            raise
-        raise UserFunctionError(f"{err} This happened {where}.") from None
-
-
-def _float_array(value, name: str) -> np.ndarray:
-    """value as a float array; None, complex or non-numeric values raise ValueError naming `name`."""
-    if value is None:
-        raise ValueError(f"{name} is None: expected an array of real numbers.")
-    arr = np.asarray(value)
-    if arr.dtype.kind == "f":
-        return arr
-    if arr.dtype.kind == "c":
-        raise ValueError(f"{name} must contain real numbers: received complex entries.")
-    try:
-        return arr.astype(float, copy=False)
-    except (TypeError, ValueError) as err:
-        raise ValueError(f"{name} must be an array of real numbers: received {type(value).__name__} "
-                         f"({err}).") from None
 
 
 def _finite(arr: np.ndarray, name: str) -> np.ndarray:
@@ -71,14 +45,14 @@ def _state_and_input(x, u, n: int, m: int) -> tuple[np.ndarray, np.ndarray]:
     it would otherwise broadcast into an (n, n) result). NaN/inf entries and
     u = None raise ValueError too; with m = 0, u may be None or empty.
     """
-    x = _finite(_float_array(x, "x"), "x")
+    x = _finite(float_array(x, "x"), "x")
     if x.ndim == 0 or x.shape[0] != n:
         raise ValueError(f"x has shape {x.shape}: expected ({n},), one entry per state, or ({n}, k) "
                          "for a batch of k states as columns.")
     batch = x.shape[1:]
     if m == 0 and (u is None or np.size(u) == 0):
         return x, np.zeros((0,) + batch)
-    u = _finite(_float_array(u, "u"), "u")
+    u = _finite(float_array(u, "u"), "u")
     if x.ndim == 1 and u.size == m and u.ndim <= 1:
         return x, u.reshape(m)
     if u.shape != (m,) + batch:
@@ -99,7 +73,7 @@ def _evaluate(func: Callable, x: np.ndarray, u: np.ndarray, name: str) -> np.nda
     return call_user_fast(func, (x, u), name, where=lambda: _at(x, u))
 
 
-def _raw_field(sys) -> Callable:
+def raw_field(sys) -> Callable:
     """The model's own f(x, u), without the argument checks and the wrapping of `sys.f`.
 
     For hot loops (`simulate`) and for callers that call it through
@@ -112,8 +86,8 @@ def _raw_field(sys) -> Callable:
     return sys._f
 
 
-def _raw_output(sys) -> Callable:
-    """The model's own h(x, u) (C x + D u, or x when h is not given), as `_raw_field` for f."""
+def raw_output(sys) -> Callable:
+    """The model's own h(x, u) (C x + D u, or x when h is not given), as `raw_field` for f."""
     if isinstance(sys, StateSpace):
         C, D = sys.C, sys.D
         return lambda x, u: C @ x + D @ u
@@ -326,8 +300,8 @@ class NonlinearSystem:
         numbers.
         """
         word = "x(t+1)" if self.is_discrete else "dx/dt"
-        _checked_call(self._f, (x, u), "f", size=self.n, where=where,
-                      what=f"{word}, one entry per state for n={self.n}")
+        checked_call(self._f, (x, u), "f", size=self.n, where=where,
+                     what=f"{word}, one entry per state for n={self.n}")
         if self._h is not None:
             call_user(self._h, (x, u), "h", where=where)
 
