@@ -287,10 +287,6 @@ class NonlinearSystem:
             return x.copy()
         return np.atleast_1d(_evaluate(self._h, x, u, "h"))
 
-    def output_size(self, x, u) -> int:
-        """Number of outputs, found by evaluating h once at (x, u)."""
-        return self.h(np.asarray(x, float), np.asarray(u, float)).size
-
     def check(self, x, u, *, where: str = "") -> None:
         """Call f, and h if given, once at (x, u) and explain what is wrong.
 

@@ -275,7 +275,7 @@ bad("StateSpace.poles", "called with an argument", lambda: sys2().poles(A2), "po
 
 function_cases("NonlinearSystem", "f", lambda f: ck.NonlinearSystem(f, n=2, m=1).check(np.zeros(2), np.zeros(1)),
                pend_f, size=2)
-function_cases("NonlinearSystem", "h", lambda h: ck.NonlinearSystem(pend_f, n=2, m=1, h=h).output_size(np.zeros(2), np.zeros(1)),
+function_cases("NonlinearSystem", "h", lambda h: ck.NonlinearSystem(pend_f, n=2, m=1, h=h).h(np.zeros(2), np.zeros(1)),
                lambda x, u: x[:1], size=1, skip=("returns wrong shape",))
 scalar_cases("NonlinearSystem", "n", lambda n: ck.NonlinearSystem(pend_f, n=n, m=1), 2, positive=True)
 bad("NonlinearSystem", "n fractional", lambda: ck.NonlinearSystem(pend_f, n=2.5, m=1), "n")

@@ -45,7 +45,7 @@ def test_nonlinear_system_checks_its_arguments():
     with pytest.raises(ValueError, match=r"n must be positive"):
         ck.NonlinearSystem(lambda x, u: x, n=0)
     sys = ck.NonlinearSystem(lambda x, u: -x, n=2, h=lambda x, u: x[0], params={"a": 1.0})
-    assert sys.output_size(np.zeros(2), np.zeros(0)) == 1
+    assert sys.h(np.zeros(2), np.zeros(0)).size == 1
     assert "a=1" in repr(sys)
 
 
