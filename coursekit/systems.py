@@ -25,10 +25,6 @@ from ._validation import (BRIDGES, as_dt, as_matrix, as_scalar, as_square, call_
 __all__ = ["StateSpace", "NonlinearSystem"]
 
 
-def _check_dt(dt, name: str = "dt") -> float | None:
-    return as_dt(dt, name)
-
-
 def _finite(arr: np.ndarray, name: str) -> np.ndarray:
     """arr itself; NaN or inf entries raise ValueError naming `name`."""
     if not np.isfinite(arr).all():
@@ -138,7 +134,7 @@ class StateSpace:
         self.D = np.zeros((p, m)) if D is None else as_matrix(
             D, "D", rows=p, cols=m, rows_why=f"one per output, since C has {p} rows",
             cols_why=f"one per input, since B has {m} columns")
-        self.dt = _check_dt(dt)
+        self.dt = as_dt(dt, "dt")
         self.name = str(name)
 
     @property
@@ -259,7 +255,7 @@ class NonlinearSystem:
             raise ValueError(f"m must be >= 0: received {m!r}.")
         self._f = f
         self._h = h
-        self.dt = _check_dt(dt)
+        self.dt = as_dt(dt, "dt")
         self.name = str(name)
         self.params = dict(params or {})
 
