@@ -99,8 +99,8 @@ def advance(tau: float, h: float, dt: float, steps: int) -> tuple[float, int]:
     if steps > _MAX_STEPS:
         raise RuntimeError(
             f"the Riccati equation (4.88) needs more than {_MAX_STEPS} RK4 steps between two "
-            "samples (its rate is huge): check the units of Q and R (module docstring), or "
-            "start from a smaller P0.")
+            "samples (its rate is huge): check the units of Q and R (docstring of "
+            "coursekit.kalman), or start from a smaller P0.")
     return (dt if h == dt - tau else tau + h), steps
 
 

@@ -175,8 +175,8 @@ def kalman_bucy(sys, t, u, y, Q, R, P0, x0, *, substeps: int = 1) -> KalmanResul
     L(t) = P(t) C^T R^{-1} (4.87) and the Riccati ODE (4.88) from
     P(0) = P0, x̂(0) = x0. `sys` is a continuous-time `StateSpace`; `u`
     (N, m) or None and `y` (N, p) are the recorded input and measurement on
-    the grid `t`. Q (n, n) >= 0 and R (p, p) > 0 are intensities (module
-    docstring). As t grows P(t) tends to the solution of `kalman_gain`.
+    the grid `t`. Q (n, n) >= 0 and R (p, p) > 0 are intensities (units:
+    `coursekit.kalman`). As t grows P(t) tends to the solution of `kalman_gain`.
 
     Returns a `KalmanResult` (estimate, P(t), L(t)). `substeps` RK4 steps
     (at least; 1 to 1000, ValueError beyond) are taken between samples.

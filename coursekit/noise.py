@@ -92,7 +92,7 @@ def _van_loan(A: np.ndarray, Q: np.ndarray, dt: float) -> tuple[np.ndarray, np.n
 def simulate_with_noise(sys, t, u=None, x0=None, *, Q, R, seed=None) -> SimulationResult:
     """Simulate x' = f(x, u) + w, y = h(x, u) + v with white noises w, v.
 
-    w has intensity Q (n, n) and v intensity R (p, p) (module docstring).
+    w has intensity Q (n, n) and v intensity R (p, p) (units: the docstring of `coursekit.kalman`).
     Returns a `SimulationResult` whose ``x`` is the true state and ``y`` the
     *noisy* measurement, each sample of v having covariance R / dt.
 
