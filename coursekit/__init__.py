@@ -23,7 +23,7 @@ _MODULES = (
     # chapter 3: stability and state feedback
     "placement", "stability", "equilibria", "linearization", "controllers",
     # chapter 4: observability and observers
-    "observability", "observers", "kalman", "kalman_discrete",
+    "observability", "observers", "kalman", "kalman_bucy", "ekf", "kalman_discrete", "noise",
     # course tools: figure style and layout
     "style", "describe",
     # course tools: environment check (exercises stay the subpackage coursekit.exercises)

@@ -15,6 +15,8 @@ from typing import Callable
 
 import numpy as np
 
+from .diagnostics import UserFunctionError
+
 __all__ = [
     "as_matrix",
     "as_square",
@@ -24,14 +26,22 @@ __all__ = [
     "as_time_grid",
     "is_uniform",
     "as_poles",
+    "as_covariance",
     "as_integer",
     "as_dt",
     "as_text",
     "as_flag",
     "time_grid",
     "check_function_output",
-    "as_system",
+    "call_user",
+    "call_user_fast",
+    "checked_call",
+    "float_array",
+    "is_complex",
+    "is_text",
     "foreign_library",
+    "type_name",
+    "BRIDGES",
 ]
 
 
@@ -44,7 +54,7 @@ def _describe(value) -> str:
     return f"{type(value).__name__} {value!r}"
 
 
-def _is_complex(value) -> bool:
+def is_complex(value) -> bool:
     """True for complex numbers or arrays, even when their imaginary parts are zero.
 
     Covers Python and numpy complex scalars and arrays, lists of them, and
@@ -69,7 +79,11 @@ def _is_complex(value) -> bool:
     return False
 
 
-def _is_text(value) -> bool:
+# the old private name, still imported by coursekit.exercises._feedback
+_is_complex = is_complex
+
+
+def is_text(value) -> bool:
     """True for a string, or a list/array of strings ("1.0" is text, not a number)."""
     if isinstance(value, (str, bytes)):
         return True
@@ -81,7 +95,7 @@ def _is_text(value) -> bool:
     return False
 
 
-def _type_name(value) -> str:
+def type_name(value) -> str:
     """The full name of value's type, e.g. ``control.statesp.StateSpace``."""
     kind = type(value)
     return kind.__qualname__ if kind.__module__ == "builtins" else f"{kind.__module__}.{kind.__qualname__}"
@@ -102,7 +116,8 @@ def foreign_library(value) -> str | None:
     return None
 
 
-_BRIDGES = {"python-control": "StateSpace.from_control", "scipy.signal": "StateSpace.from_scipy"}
+#: the StateSpace constructor that converts a system of each neighbouring library
+BRIDGES = {"python-control": "StateSpace.from_control", "scipy.signal": "StateSpace.from_scipy"}
 
 
 def _refuse_system_as_matrix(value, name: str) -> None:
@@ -112,9 +127,9 @@ def _refuse_system_as_matrix(value, name: str) -> None:
         library = "coursekit"
     if library is None:
         return
-    bridge = f", or convert the system with {_BRIDGES[library]}(sys)" if library in _BRIDGES else ""
+    bridge = f", or convert the system with {BRIDGES[library]}(sys)" if library in BRIDGES else ""
     raise ValueError(
-        f"{name} must be a matrix: received a {library} system ({_type_name(value)}); pass its "
+        f"{name} must be a matrix: received a {library} system ({type_name(value)}); pass its "
         f"matrix, e.g. sys.{name if name in ('A', 'B', 'C', 'D') else 'A'}{bridge}."
     )
 
@@ -123,12 +138,12 @@ def _to_float_array(value, name: str) -> np.ndarray:
     if value is None:
         raise ValueError(f"{name} is missing: received None, expected a number or an array.")
     _refuse_system_as_matrix(value, name)
-    if _is_text(value):
+    if is_text(value):
         raise ValueError(
             f"{name} must contain real numbers: received the text {value!r}; type the numbers "
             "themselves, e.g. 0.5 or [[0, 1], [-2, -3]], without quotes."
         )
-    if _is_complex(value):
+    if is_complex(value):
         raise ValueError(
             f"{name} must contain real numbers: received {_describe(value)} with complex "
             "entries; pass the real matrix (complex numbers are only accepted as poles)."
@@ -332,6 +347,34 @@ def is_uniform(t: np.ndarray, rtol: float = 1e-9) -> bool:
     return bool(np.all(np.abs(steps - steps[0]) <= rtol * max(abs(steps[0]), np.abs(t).max())))
 
 
+def as_covariance(value, name: str, size: int, *, definite: bool, why: str = "") -> np.ndarray:
+    """A symmetric (size x size) matrix, positive definite or semidefinite (Q, R, P0 of (4.88)).
+
+    `why` says where `size` comes from ("one row and column per state, since A is 2x2").
+    """
+    M = as_square(value, name)
+    if M.shape[0] != size:
+        reason = f" ({why})" if why else ""
+        raise ValueError(f"{name} has the wrong size: received shape {M.shape}, expected "
+                         f"({size}, {size}){reason}.")
+    if not np.allclose(M, M.T, rtol=1e-10, atol=1e-12 * max(1.0, np.abs(M).max())):
+        raise ValueError(f"{name} must be symmetric: received {M.tolist()!r}; use (M + M.T) / 2.")
+    M = (M + M.T) / 2
+    low = float(np.linalg.eigvalsh(M).min())
+    scale = max(1.0, float(np.abs(M).max()))
+    if definite and low <= 1e-12 * scale:
+        raise ValueError(
+            f"{name} must be positive definite: its smallest eigenvalue is {low:.3g}; "
+            f"expected every eigenvalue > 0 (e.g. a diagonal matrix with positive entries)."
+        )
+    if not definite and low < -1e-10 * scale:
+        raise ValueError(
+            f"{name} must be positive semidefinite: its smallest eigenvalue is {low:.3g} < 0; "
+            "expected a covariance-like matrix such as np.diag([q1, q2])."
+        )
+    return M
+
+
 def as_poles(poles, name: str = "poles", *, count: int) -> np.ndarray:
     """Return `poles` as a complex array of length `count`, closed under conjugation.
 
@@ -366,15 +409,72 @@ def as_poles(poles, name: str = "poles", *, count: int) -> np.ndarray:
     return arr
 
 
+def _shapes(args) -> str:
+    return ", ".join(str(np.shape(a)) for a in args)
+
+
+def call_user(func: Callable, args: tuple, name: str, *, where: str = "",
+              finite: bool = True) -> np.ndarray:
+    """Call the user's `func(*args)`; return its value as a float array.
+
+    Raises `UserFunctionError` (a ValueError) naming `name` and `where`
+    ("at t = 0.3", "at x_eq") when the call raises, returns something that
+    is not numbers, or (with `finite`) returns NaN or inf.
+    """
+    if not callable(func):
+        raise TypeError(f"{name} must be a function: received {type(func).__name__}.")
+    place = f" {where}" if where else ""
+    try:
+        out = func(*args)
+    except Exception as err:  # the user's own code: say which function and where
+        raise UserFunctionError(
+            f"{name} raised {type(err).__name__}{place} (called with arguments of shapes "
+            f"{_shapes(args)}): {err}"
+        ) from err
+    if out is None:
+        raise UserFunctionError(f"{name} returned None{place}; did the function forget to return?")
+    if is_complex(out):
+        raise UserFunctionError(f"{name} returned complex numbers{place}; expected real numbers.")
+    try:
+        arr = np.asarray(out, dtype=float)
+    except (TypeError, ValueError) as err:
+        raise UserFunctionError(
+            f"{name} returned {type(out).__name__}{place}, which is not an array of real numbers ({err})."
+        ) from None
+    if finite and not np.all(np.isfinite(arr)):
+        raise UserFunctionError(
+            f"{name} returned NaN or inf{place}: {np.array2string(arr, precision=4)}. Look in "
+            f"{name} for a division by zero, a square root or logarithm of a negative number, or a "
+            "state that has grown without bound."
+        )
+    return arr
+
+
+def call_user_fast(func: Callable, args: tuple, name: str, *, where: Callable[[], str]) -> np.ndarray:
+    """`call_user` for hot loops (a model called at every solver or filter step).
+
+    Finite real numbers are returned after one check. Anything else (an
+    exception, None, complex, NaN/inf, not numbers) repeats the call through
+    `call_user`, whose `UserFunctionError` explains it; `where()` builds the
+    context string only then.
+    """
+    try:
+        value = np.asarray(func(*args))
+        if value.dtype.kind in "fiu" and np.isfinite(value).all():
+            return value.astype(float, copy=False)
+    except Exception:  # explained below, by the repeated call
+        pass
+    return call_user(func, args, name, where=where())
+
+
 def check_function_output(func: Callable, args: tuple, name: str, *, size: int, what: str) -> np.ndarray:
     """Call a user function once and explain a wrong return value before integrating.
 
     `what` says what the value means ("dx/dt, one entry per state"). Raises
     `UserFunctionError` (a ValueError) naming `name` when the call raises or
-    returns None, text, complex numbers, NaN or inf (see `diagnostics.call_user`),
+    returns None, text, complex numbers, NaN or inf (see `call_user`),
     and ValueError when it returns the wrong number of values.
     """
-    from .diagnostics import call_user
     if not callable(func):
         raise ValueError(f"{name} must be a function: received {_describe(func)}; expected {what}.")
     arr = call_user(func, args, name, where="when called once as a check")
@@ -383,62 +483,31 @@ def check_function_output(func: Callable, args: tuple, name: str, *, size: int, 
     return arr.ravel()
 
 
-_KINDS = {"any": "StateSpace or NonlinearSystem", "linear": "StateSpace", "nonlinear": "NonlinearSystem"}
+def checked_call(func: Callable, args: tuple, name: str, *, size: int, what: str,
+                 where: str = "") -> np.ndarray:
+    """Call a user function once: an exception, None or NaN/inf is explained by
+    `call_user` (naming `name` and `where`), a wrong return shape by
+    `check_function_output`'s rule; returns the value as a flat float array."""
+    value = call_user(func, args, name, where=where)
+    try:
+        return check_function_output(lambda *_: value, args, name, size=size, what=what)
+    except ValueError as err:
+        if not where:
+            raise
+        raise UserFunctionError(f"{err} This happened {where}.") from None
 
 
-def _system_received(value) -> str:
-    """How a refused system argument is described: its time base, or its full type name."""
-    if isinstance(value, np.ndarray):
-        return f"a numpy array of shape {value.shape}"
-    if hasattr(value, "is_discrete") and type(value).__module__ == "coursekit.systems":
-        base, period = ("discrete", f" (dt={value.dt:g})") if value.is_discrete else ("continuous", "")
-        return f"a {base}-time {type(value).__name__}{period}"
-    return _type_name(value)
-
-
-def as_system(value, name: str = "sys", *, kind: str = "any", time: str = "", hint: str = ""):
-    """Return `value` as a coursekit system, converting python-control and scipy.signal ones.
-
-    `kind` is "any" (StateSpace or NonlinearSystem), "linear" (StateSpace) or
-    "nonlinear"; `time` is "", "continuous" or "discrete". A ``control.StateSpace``
-    or ``scipy.signal.StateSpace`` (also ``scipy.signal.lti(A, B, C, D)``) goes through
-    the bridges `StateSpace.from_control` / `from_scipy` (the same matrices (1.24) and
-    time base); one whose time base is unspecified (``dt=True``, or python-control's
-    ``dt=None``) is refused, because reading it as dt = 1 or as continuous is the user's
-    choice, and so is choosing the realization of a transfer function: both messages
-    name the bridge. Anything else raises ValueError naming `name`, the wanted kind and
-    the full type name of what was received, followed by `hint`.
-    """
-    from .systems import NonlinearSystem, StateSpace
-    library = foreign_library(value)
-    if library is not None:
-        value = _from_foreign(value, name, library)
-    wanted = (StateSpace, NonlinearSystem) if kind == "any" else \
-        StateSpace if kind == "linear" else NonlinearSystem
-    right_time = not time or isinstance(value, (StateSpace, NonlinearSystem)) and \
-        value.is_discrete == (time == "discrete")
-    if not isinstance(value, wanted) or not right_time:
-        base = f"{time}-time " if time else ""
-        raise ValueError(f"{name} must be a {base}{_KINDS[kind]}: received {_system_received(value)}"
-                         + (f"; {hint}" if hint else "."))
-    return value
-
-
-def _from_foreign(value, name: str, library: str):
-    """The coursekit StateSpace of a python-control / scipy.signal state-space object (bridges)."""
-    from .bridges import realization_hint
-    from .systems import StateSpace
-    module = _sys.modules["control" if library == "python-control" else "scipy.signal"]
-    bridge = _BRIDGES[library]
-    if not isinstance(value, module.StateSpace):
-        raise ValueError(f"{name} must be a state-space system: received {_type_name(value)}. "
-                         f"{realization_hint(value)} Then convert it with {bridge}(sys).")
-    dt = value.dt
-    if dt is True or (dt is None and library == "python-control"):
-        raise ValueError(
-            f"{name} is a {library} system whose time base is unspecified (dt={dt!r}): "
-            f"convert it with {bridge}(sys), which reads dt=True as a period of 1 and "
-            "python-control's dt=None as continuous time, or build it with dt=0 (continuous) "
-            "or the sampling period."
-        )
-    return getattr(StateSpace, bridge.split(".")[1])(value)
+def float_array(value, name: str) -> np.ndarray:
+    """value as a float array; None, complex or non-numeric values raise ValueError naming `name`."""
+    if value is None:
+        raise ValueError(f"{name} is None: expected an array of real numbers.")
+    arr = np.asarray(value)
+    if arr.dtype.kind == "f":
+        return arr
+    if arr.dtype.kind == "c":
+        raise ValueError(f"{name} must contain real numbers: received complex entries.")
+    try:
+        return arr.astype(float, copy=False)
+    except (TypeError, ValueError) as err:
+        raise ValueError(f"{name} must be an array of real numbers: received {type(value).__name__} "
+                         f"({err}).") from None

@@ -109,8 +109,11 @@ def realization_hint(sys) -> str:
             "system first (`sys.linearize(xeq, ueq)` or coursekit's `linearize`).")
 
 
-def from_control(sys):
+def from_control(sys, cls):
     """coursekit `StateSpace` with the matrices and time base of a python-control system.
+
+    `cls` is coursekit's StateSpace class, passed in by the classmethod
+    `StateSpace.from_control` so that this module does not import `systems`.
 
     Accepts a ``control.StateSpace`` (MIMO, with or without inputs). The matrices are
     copied exactly; the time base is mapped as the module docstring says (dt=0 ->
@@ -118,8 +121,6 @@ def from_control(sys):
     else, saying how to get a state-space model (``control.ss(G)`` for a transfer
     function), and ImportError naming ``pip install control`` when python-control is missing.
     """
-    from .systems import StateSpace
-
     control = _import_control()
     if not isinstance(sys, control.StateSpace):
         hint = realization_hint(sys) if isinstance(sys, control.InputOutputSystem) else \
@@ -131,7 +132,7 @@ def from_control(sys):
             "use the matrix sys.D directly."
         )
     name = "" if sys.name is None or _GENERIC_CONTROL_NAME.fullmatch(sys.name) else sys.name
-    return StateSpace(_copy(sys.A), _copy(sys.B), _copy(sys.C), _copy(sys.D),
+    return cls(_copy(sys.A), _copy(sys.B), _copy(sys.C), _copy(sys.D),
                       dt=_dt_to_coursekit(sys.dt, "python-control"), name=name)
 
 
@@ -162,8 +163,8 @@ def to_control(ss):
         ) from err
 
 
-def from_scipy(sys):
-    """coursekit `StateSpace` with the matrices and time base of a ``scipy.signal`` system.
+def from_scipy(sys, cls):
+    """coursekit `StateSpace` (`cls`, as for `from_control`) with the matrices and time base of a ``scipy.signal`` system.
 
     Accepts ``scipy.signal.StateSpace`` objects, continuous (``dt=None``) or discrete
     (``dt`` a period, or True -> dt=1). The matrices are copied exactly. A
@@ -172,13 +173,11 @@ def from_scipy(sys):
     """
     import scipy.signal as signal
 
-    from .systems import StateSpace
-
     if not isinstance(sys, signal.StateSpace):
         hint = realization_hint(sys) if isinstance(sys, (signal.lti, signal.dlti)) else \
             _other_hint(sys, "scipy.signal.StateSpace(A, B, C, D)")
         raise _refuse(sys, "scipy.signal", hint)
-    return StateSpace(_copy(sys.A), _copy(sys.B), _copy(sys.C), _copy(sys.D),
+    return cls(_copy(sys.A), _copy(sys.B), _copy(sys.C), _copy(sys.D),
                       dt=_dt_to_coursekit(sys.dt, "scipy.signal"))
 
 

@@ -20,7 +20,7 @@ column k by a^(k+1), and changing state units (x -> D x) rescales the rows,
 so the numerical rank of Wc, unlike the true one, depends on the units.
 
 coursekit decides instead with quantities that units do not change
-(`_controllability`):
+(`unit_free_staircase`):
 
 1. *units*: A is divided by its norm (this removes the time unit exactly:
    a A / |a A| = A / |A|) and each column of B by its norm (input units);
@@ -58,6 +58,11 @@ times its tolerance; random N(0, 1) systems up to n = 30 in any units
 (a DC motor, a cart-pendulum, a building, ...) keep their verdicts in any
 units (margin = smallest coupling / its tolerance; below 100 a verdict is
 called marginal in the error messages).
+
+Shared within coursekit (not in ``ck.*``): observability works on the dual pair
+(A^T, C^T) with the same tools, so `as_pair`, `ctrb_unchecked`, `numerical_rank`,
+`Staircase`, `unit_free_staircase`, `check_tol`, `marginal_note` and
+`canonical_transform` carry no underscore; placement and trajectory use `as_pair`.
 """
 
 from __future__ import annotations
@@ -66,12 +71,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import as_matrix, as_square, as_system
-from .diagnostics import warn_accuracy
-from .systems import StateSpace
+from ._validation import as_matrix, as_square
+from .diagnostics import NotControllableError, warn_accuracy
+from .systems import StateSpace, as_system
 
 __all__ = [
-    "NotControllableError",
     "ctrb",
     "ctrb_singular_values",
     "is_controllable",
@@ -87,11 +91,8 @@ _MARGINAL = 100.0
 _AMPLIFICATION_CAP = 1e3
 
 
-class NotControllableError(ValueError):
-    """Raised when an algorithm needs a controllable pair (A, B) and it is not."""
-
-
-def _pair(A, B):
+def as_pair(A, B):
+    """(A, B) checked: A square (n, n), B with n rows (a 1-D B is one column) and at least one column."""
     A = as_square(A, "A")
     n = A.shape[0]
     B = as_matrix(B, "B", rows=n, rows_why=f"one per state, since A is {n}x{n}",
@@ -101,7 +102,8 @@ def _pair(A, B):
     return A, B
 
 
-def _ctrb(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+def ctrb_unchecked(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+    """Wc = [B, AB, ..., A^(n-1) B] (2.13) for arrays already checked by `as_pair`."""
     blocks = [B]
     for _ in range(A.shape[0] - 1):
         blocks.append(A @ blocks[-1])
@@ -115,8 +117,8 @@ def ctrb(A, B) -> np.ndarray:
     numerical rank depends on units (see the module docstring): decide
     controllability with `is_controllable`, not with ``matrix_rank(ctrb(A, B))``.
     """
-    A, B = _pair(A, B)
-    return _ctrb(A, B)
+    A, B = as_pair(A, B)
+    return ctrb_unchecked(A, B)
 
 
 def ctrb_singular_values(A, B) -> np.ndarray:
@@ -128,7 +130,7 @@ def ctrb_singular_values(A, B) -> np.ndarray:
     return np.linalg.svd(ctrb(A, B), compute_uv=False)
 
 
-def _rank(W: np.ndarray, tol: float | None) -> int:
+def numerical_rank(W: np.ndarray, tol: float | None) -> int:
     """Numerical rank of W: singular values above tol (default NumPy's matrix_rank rule)."""
     s = np.linalg.svd(W, compute_uv=False)
     if tol is None:
@@ -137,8 +139,8 @@ def _rank(W: np.ndarray, tol: float | None) -> int:
 
 
 @dataclass(frozen=True)
-class _Staircase:
-    """The outcome of `_controllability`, in the unit-free coordinates it works in.
+class Staircase:
+    """The outcome of `unit_free_staircase`, in the unit-free coordinates it works in.
 
     The scaled pair is ``A_s = D^-1 A D / alpha``, ``B_s = D^-1 B / beta``
     (``d`` the diagonal of D, ``beta`` one factor per input). ``Q`` is
@@ -226,7 +228,7 @@ def _krylov_scaling(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     nilpotent A, so that Wc neither overflows nor underflows.
     """
     rho = np.abs(np.linalg.eigvals(A)).max(initial=0.0)
-    W = _ctrb(A / max(rho, 1e-4), B)
+    W = ctrb_unchecked(A / max(rho, 1e-4), B)
     rows = np.linalg.norm(W, axis=1)
     s = np.ones(A.shape[0])
     reached = (rows > 0) & np.isfinite(rows)
@@ -250,7 +252,7 @@ def _unit_free(A: np.ndarray, B: np.ndarray):
     return A, B, d, alpha, beta
 
 
-def _controllability(A: np.ndarray, B: np.ndarray, tol: float | None = None) -> _Staircase:
+def unit_free_staircase(A: np.ndarray, B: np.ndarray, tol: float | None = None) -> Staircase:
     """Step 3 of the module docstring: the orthogonal staircase of the unit-free pair."""
     A_s, B_s, d, alpha, beta = _unit_free(A, B)
     n = A.shape[0]
@@ -272,11 +274,12 @@ def _controllability(A: np.ndarray, B: np.ndarray, tol: float | None = None) -> 
         Q[:, k:] = Q[:, k:] @ U
         k += r
         Bk, Ak = Ak[r:, :r], Ak[r:, r:]
-    return _Staircase(rank=k, A_s=A_s, B_s=B_s, d=d, alpha=alpha, beta=beta, Q=Q,
-                      margin=margin, excess=excess)
+    return Staircase(rank=k, A_s=A_s, B_s=B_s, d=d, alpha=alpha, beta=beta, Q=Q,
+                     margin=margin, excess=excess)
 
 
-def _check_tol(tol):
+def check_tol(tol):
+    """`tol` of `is_controllable` / `is_observable` checked: None (the default) or a number in (0, 1)."""
     if tol is None:
         return None
     if not isinstance(tol, (int, float, np.integer, np.floating)) or not 0 < float(tol) < 1:
@@ -303,11 +306,12 @@ def is_controllable(A, B, *, tol: float | None = None) -> bool:
     uncontrollable. (Before coursekit 0.2 it was an absolute threshold on
     the singular values of Wc.) Takes a few milliseconds for n = 30.
     """
-    A, B = _pair(A, B)
-    return _controllability(A, B, _check_tol(tol)).rank == A.shape[0]
+    A, B = as_pair(A, B)
+    return unit_free_staircase(A, B, check_tol(tol)).rank == A.shape[0]
 
 
-def _marginal_note(v: _Staircase, verdict: str) -> str:
+def marginal_note(v: Staircase, verdict: str) -> str:
+    """The sentence an error message adds when the staircase verdict `v` is marginal, else ""."""
     if not v.marginal:
         return ""
     return (
@@ -319,14 +323,14 @@ def _marginal_note(v: _Staircase, verdict: str) -> str:
 
 
 def require_controllable(A: np.ndarray, B: np.ndarray, *, purpose: str,
-                         tol: float | None = None) -> _Staircase:
+                         tol: float | None = None) -> Staircase:
     """Return the staircase of (A, B), or raise NotControllableError saying what failed.
 
     The verdict is `is_controllable`'s; the message says how many
     directions cannot be reached, what to do, and whether the decision was
     marginal (the system close to the boundary between the two verdicts).
     """
-    v = _controllability(A, B, _check_tol(tol))
+    v = unit_free_staircase(A, B, check_tol(tol))
     n, r = A.shape[0], v.rank
     if r < n:
         raise NotControllableError(
@@ -335,7 +339,7 @@ def require_controllable(A: np.ndarray, B: np.ndarray, *, purpose: str,
             "without units by an orthogonal staircase of the balanced pair; see "
             f"is_controllable). {n - r} direction(s) of the state cannot be influenced by u: "
             "add an actuator (a column of B) that acts on them, or check the entries of A "
-            "and B." + _marginal_note(v, "nearly controllable")
+            "and B." + marginal_note(v, "nearly controllable")
         )
     return v
 
@@ -350,7 +354,7 @@ def charpoly(A) -> np.ndarray:
     return np.real(np.poly(A))[::-1][:-1].copy()
 
 
-def _ccf_rows(v: _Staircase) -> np.ndarray:
+def _ccf_rows(v: Staircase) -> np.ndarray:
     """The CCF transform of the unit-free single-input pair (A_s, b_s) of `v`.
 
     Its first row is orthogonal to b_s, A_s b_s, ..., A_s^(n-2) b_s, i.e. it
@@ -367,7 +371,7 @@ def _ccf_rows(v: _Staircase) -> np.ndarray:
     return Ts / (Ts[-1] @ v.B_s[:, 0])
 
 
-def _ccf_deviation(Ts: np.ndarray, v: _Staircase) -> tuple[float, float]:
+def _ccf_deviation(Ts: np.ndarray, v: Staircase) -> tuple[float, float]:
     """How far Ts misses the CCF, as a multiple of what rounding explains, and absolutely.
 
     Checks ``T B = e_n`` (each row against ``|T_i| |B|``, 2-norms) and that rows
@@ -391,9 +395,9 @@ def _ccf_deviation(Ts: np.ndarray, v: _Staircase) -> tuple[float, float]:
     return miss / (100 * n * _EPS * np.linalg.cond(Ts)), miss
 
 
-def _canonical_transform(A: np.ndarray, B: np.ndarray, *, form: str, purpose: str,
-                         equations: str = "T B = e_n and the structure of T A T^-1",
-                         require=None) -> np.ndarray:
+def canonical_transform(A: np.ndarray, B: np.ndarray, *, form: str, purpose: str,
+                        equations: str = "T B = e_n and the structure of T A T^-1",
+                        require=None) -> np.ndarray:
     """T with z = T x in the CCF of (A, B), checked; `form` and `equations` name it in the warning."""
     require = require or require_controllable
     v = require(A, B, purpose=purpose)
@@ -434,7 +438,7 @@ def ccf_transform(A, B) -> np.ndarray:
     Single input only (B of shape (n, 1)). Raises `NotControllableError` when
     (A, B) is not controllable: an uncontrollable system has no CCF.
     """
-    A, B = _pair(A, B)
+    A, B = as_pair(A, B)
     n, m = B.shape
     if m != 1:
         raise ValueError(
@@ -442,8 +446,8 @@ def ccf_transform(A, B) -> np.ndarray:
             "the CCF (2.16) is defined for one input. Pick one column of B, or use place() "
             "which handles several inputs."
         )
-    return _canonical_transform(A, B, form="controllability canonical form (2.16)",
-                                purpose="a transform to the controllability canonical form")
+    return canonical_transform(A, B, form="controllability canonical form (2.16)",
+                               purpose="a transform to the controllability canonical form")
 
 
 # cond(T) eps above 2e-6 (a millionth, as the checks of the pole placement): the transform warns

@@ -22,9 +22,9 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_square, as_system, as_vector
+from ._validation import as_matrix, as_scalar, as_square, as_vector, checked_call, float_array
 from .diagnostics import UserFunctionError
-from .systems import NonlinearSystem, StateSpace, _checked_call, _float_array
+from .systems import NonlinearSystem, StateSpace, as_system
 
 __all__ = [
     "StateFeedback",
@@ -51,7 +51,7 @@ def _states(x, n: int, name: str = "x", gain: str = "") -> np.ndarray:
     broadcast into a wrong answer), which names `gain` ("K is 1x3") when given."""
     x = np.asarray(x)
     if x.dtype.kind != "f":
-        x = _float_array(x, name)
+        x = float_array(x, name)
     if x.ndim not in (1, 2) or x.shape[0] != n:
         since = f", since {gain}" if gain else ""
         raise ValueError(f"{name} has shape {x.shape}: expected ({n},), one entry per state{since}, "
@@ -110,7 +110,7 @@ def _trajectory(func, name: str, size: int, what: str) -> Callable:
                          f"received {type(func).__name__}.")
 
     def explain(t, err=None):
-        _checked_call(func, (t,), name, size=size, what=what, where=f"at t = {t:.6g}")
+        checked_call(func, (t,), name, size=size, what=what, where=f"at t = {t:.6g}")
         raise UserFunctionError(f"{name} failed at t = {t:.6g}, but returned {size} finite numbers "
                                 "when called again: does it change between calls?") from err
 

@@ -11,20 +11,22 @@
   h, an input u(t, x), a control law) raised, or returned NaN/inf, while
   coursekit called it. The message names the function, where it was called
   (time, state) and what it returned; the original exception is chained.
-* `call_user(func, args, name, where=...)` calls such a function with that
-  context and returns its value as a finite float array.
+* `SimulationError`: `simulate` cannot reach the end of the time grid.
+* `NotControllableError`, `NotObservableError`: an algorithm needs a
+  controllable pair (A, B) (Kalman's rank condition (2.13)) or an observable pair
+  (A, C) (its dual, chapter 4) and the pair is not one.
+
+Every exception and warning class of coursekit is defined here, and this
+module imports nothing from coursekit, so every other module may import it.
+(Calling a user's function with this context is `_validation.call_user`.)
 """
 
 from __future__ import annotations
 
 import warnings
-from typing import Callable
 
-import numpy as np
-
-from ._validation import _is_complex
-
-__all__ = ["CoursekitWarning", "AccuracyWarning", "UserFunctionError", "call_user"]
+__all__ = ["CoursekitWarning", "AccuracyWarning", "UserFunctionError", "SimulationError",
+           "NotControllableError", "NotObservableError"]
 
 
 class CoursekitWarning(UserWarning):
@@ -39,62 +41,23 @@ class UserFunctionError(ValueError):
     """A user-supplied function raised or returned NaN/inf when coursekit called it."""
 
 
-def _shapes(args) -> str:
-    return ", ".join(str(np.shape(a)) for a in args)
+class SimulationError(ValueError, RuntimeError):
+    """The simulation cannot reach the end of the time grid.
 
-
-def call_user(func: Callable, args: tuple, name: str, *, where: str = "",
-              finite: bool = True) -> np.ndarray:
-    """Call the user's `func(*args)`; return its value as a float array.
-
-    Raises `UserFunctionError` (a ValueError) naming `name` and `where`
-    ("at t = 0.3", "at x_eq") when the call raises, returns something that
-    is not numbers, or (with `finite`) returns NaN or inf.
+    Raised when the state overflows the float range (about 1.8e308: an
+    unstable system simulated for too long, or a solution with a finite
+    escape time) and when the ODE solver gives up. The message says at
+    which time, why, and what to try. It is both a ValueError and a
+    RuntimeError, so either catches it.
     """
-    if not callable(func):
-        raise TypeError(f"{name} must be a function: received {type(func).__name__}.")
-    place = f" {where}" if where else ""
-    try:
-        out = func(*args)
-    except Exception as err:  # the user's own code: say which function and where
-        raise UserFunctionError(
-            f"{name} raised {type(err).__name__}{place} (called with arguments of shapes "
-            f"{_shapes(args)}): {err}"
-        ) from err
-    if out is None:
-        raise UserFunctionError(f"{name} returned None{place}; did the function forget to return?")
-    if _is_complex(out):
-        raise UserFunctionError(f"{name} returned complex numbers{place}; expected real numbers.")
-    try:
-        arr = np.asarray(out, dtype=float)
-    except (TypeError, ValueError) as err:
-        raise UserFunctionError(
-            f"{name} returned {type(out).__name__}{place}, which is not an array of real numbers ({err})."
-        ) from None
-    if finite and not np.all(np.isfinite(arr)):
-        raise UserFunctionError(
-            f"{name} returned NaN or inf{place}: {np.array2string(arr, precision=4)}. Look in "
-            f"{name} for a division by zero, a square root or logarithm of a negative number, or a "
-            "state that has grown without bound."
-        )
-    return arr
 
 
-def call_user_fast(func: Callable, args: tuple, name: str, *, where: Callable[[], str]) -> np.ndarray:
-    """`call_user` for hot loops (a model called at every solver or filter step).
+class NotControllableError(ValueError):
+    """Raised when an algorithm needs a controllable pair (A, B) and it is not."""
 
-    Finite real numbers are returned after one check. Anything else (an
-    exception, None, complex, NaN/inf, not numbers) repeats the call through
-    `call_user`, whose `UserFunctionError` explains it; `where()` builds the
-    context string only then.
-    """
-    try:
-        value = np.asarray(func(*args))
-        if value.dtype.kind in "fiu" and np.isfinite(value).all():
-            return value.astype(float, copy=False)
-    except Exception:  # explained below, by the repeated call
-        pass
-    return call_user(func, args, name, where=where())
+
+class NotObservableError(ValueError):
+    """Raised when an algorithm needs an observable pair (A, C) and it is not."""
 
 
 def warn_accuracy(message: str, *, stacklevel: int = 3) -> None:

@@ -31,8 +31,7 @@ from pathlib import Path
 
 from ._validation import as_flag
 
-__all__ = ["check_environment", "EnvironmentReport", "MINIMUM_VERSIONS", "find_widget_frontend",
-           "detect_host"]
+__all__ = ["check_environment", "EnvironmentReport", "MINIMUM_VERSIONS", "find_widget_frontend"]
 
 #: lower bounds of pyproject.toml (dependencies and the dev extra); a test keeps them in sync
 MINIMUM_VERSIONS = {

@@ -13,10 +13,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_dt, as_integer, as_matrix, as_scalar, as_system, as_vector, foreign_library
-from .diagnostics import UserFunctionError, call_user
-from .linearization import _function_name, _input_size_explained, _sympy_column
-from .systems import NonlinearSystem, StateSpace, _raw_field
+from ._validation import as_dt, as_integer, as_matrix, as_scalar, as_vector, call_user, foreign_library
+from .diagnostics import UserFunctionError
+from .linearization import function_name, input_size_explained, sympy_column
+from .systems import NonlinearSystem, StateSpace, as_system, raw_field
 
 __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
 
@@ -26,13 +26,13 @@ def _field(f, n=None, dt=None):
     if foreign_library(f):
         f = as_system(f, "f")
     if isinstance(f, (NonlinearSystem, StateSpace)):
-        return _raw_field(f), _function_name(getattr(f, "_f", f.f)), f.n, f.m, f.dt
+        return raw_field(f), function_name(getattr(f, "_f", f.f)), f.n, f.m, f.dt
     if not callable(f):
         raise ValueError(
             f"f must be a NonlinearSystem or a function f(x, u) returning dx/dt: received "
             f"{type(f).__name__}."
         )
-    return f, _function_name(f), n, None, dt
+    return f, function_name(f), n, None, dt
 
 
 def _residual(func, name: str, dt, task: str, *, finite: bool = False):
@@ -101,7 +101,7 @@ def find_equilibria(f, u_eq=None, guesses=None, *, n=None, dt=None, bounds=(-5.0
     u = _input(u_eq, m)
     X0 = _guesses(guesses, n_sys, bounds, count, seed)
     task = "find_equilibria, searching from the guess {}"
-    with _input_size_explained(u_eq, u, "find_equilibria"):
+    with input_size_explained(u_eq, u, "find_equilibria"):
         _check_at_guesses(func, name, dt, u, X0, task, inferred=n_sys is None)
     from scipy.optimize import root
     found = []
@@ -248,8 +248,8 @@ def symbolic_equilibria(f, unknowns, *, discrete: bool = False):
     removes the solutions at 0.
     """
     import sympy as sp
-    F = list(_sympy_column(f, "f"))
-    X = list(_sympy_column(unknowns, "unknowns", allow_empty=True)) if unknowns is not None else []
+    F = list(sympy_column(f, "f"))
+    X = list(sympy_column(unknowns, "unknowns", allow_empty=True)) if unknowns is not None else []
     if not X or not all(isinstance(v, sp.Symbol) for v in X):
         raise ValueError(f"unknowns must be a non-empty list of sympy symbols: received {unknowns!r}.")
     if discrete:

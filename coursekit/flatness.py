@@ -29,9 +29,9 @@ from typing import Callable
 import numpy as np
 
 from ._validation import as_flag, as_matrix, as_scalar, as_vector
-from .controllability import _pair, ccf_transform, charpoly
+from .controllability import as_pair, ccf_transform, charpoly
 from .diagnostics import warn_accuracy
-from .trajectory import _PLAN_RTOL, _input_time, _plan_grid, plot_plan, poly_trajectory
+from .trajectory import PLAN_RTOL, input_time, plan_grid, plot_plan, poly_trajectory
 
 __all__ = [
     "FlatSystem",
@@ -119,7 +119,7 @@ def linear_flatness(A, B) -> FlatSystem:
     The maps are checked against their defining equations (`_check_linear_maps`);
     an `AccuracyWarning` says when an ill-conditioned CCF transform breaks them.
     """
-    A, B = _pair(A, B)
+    A, B = as_pair(A, B)
     n = A.shape[0]
     T = ccf_transform(A, B)
     a = charpoly(A)
@@ -336,7 +336,7 @@ class FlatPlan:
 
     def input(self, t, x=None) -> np.ndarray:
         """``u(t, x)`` for `simulate`: open loop, x is ignored (t is clipped to [0, T])."""
-        tt = _input_time(t, self.horizon)
+        tt = input_time(t, self.horizon)
         # the same maps as u(t), without re-checking the inputs at every solver step
         columns = [traj._scalar_derivatives(tt, self.flat.order_u) for traj in self.trajectories]
         D = [np.array([[col[k] for col in columns]]) for k in range(self.flat.order_u + 1)]
@@ -344,7 +344,7 @@ class FlatPlan:
 
     def plot(self, samples: int = 301):
         """Figure of the planned state psi_x and input psi_u on [0, T]; returns the figure."""
-        t = _plan_grid(self.horizon, samples)
+        t = plan_grid(self.horizon, samples)
         return plot_plan(t, self.x(t), self.u(t), title=f"flat plan for the {self.flat.name} (2.88)-(2.89)")
 
     @property
@@ -419,7 +419,7 @@ def _check_flat_plan(plan: FlatPlan, caller: str, x0, xT, *, angle: int | None =
     """Warn unless the plan's x(0), x(T) from psi_x meet the requested x0, xT.
 
     `angle` is the index of a state compared modulo 2 pi (a heading); the
-    others are compared to _PLAN_RTOL of the largest requested state.
+    others are compared to PLAN_RTOL of the largest requested state.
     """
     got = [_planned_state(plan, t) for t in (0.0, plan.horizon)]
     diffs = [g - w for g, w in zip(got, (x0, xT))]
@@ -427,7 +427,7 @@ def _check_flat_plan(plan: FlatPlan, caller: str, x0, xT, *, angle: int | None =
         for d in diffs:
             d[angle] = np.arctan2(np.sin(d[angle]), np.cos(d[angle]))
     task = max(1.0 if angle is not None else 0.0, np.abs(x0).max(), np.abs(xT).max())
-    allowed = _PLAN_RTOL * (task if task > 0 else 1.0)
+    allowed = PLAN_RTOL * (task if task > 0 else 1.0)
     misses = [float(np.abs(d).max()) for d in diffs]
     if all(miss <= allowed for miss in misses):
         return
@@ -436,7 +436,7 @@ def _check_flat_plan(plan: FlatPlan, caller: str, x0, xT, *, angle: int | None =
     warn_accuracy(
         f"{caller}: the plan's {when} = psi_x(F_d, F_d', ...) (2.88) is "
         f"{np.array2string(got[k], precision=6)} instead of {np.array2string(wanted, precision=6)}, "
-        f"off by {misses[k]:.3g}, more than {_PLAN_RTOL:g} of the requested states' size {task:.3g}. "
+        f"off by {misses[k]:.3g}, more than {PLAN_RTOL:g} of the requested states' size {task:.3g}. "
         "The flat output misses its boundary conditions (see the poly_trajectory warning) or "
         "psi_x amplifies their rounding; try a horizon T nearer 1 in the time unit used or fewer "
         "boundary conditions.",

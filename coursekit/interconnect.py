@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_scalar, as_system
-from .systems import StateSpace
+from ._validation import as_scalar
+from .systems import StateSpace, as_system
 
 __all__ = ["cascade", "feedback"]
 

@@ -27,9 +27,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_series, as_system
-from .kalman import KalmanResult, _covariance, _initial_estimate
-from .systems import StateSpace
+from ._filter_ode import initial_estimate
+from ._validation import as_covariance, as_series
+from .kalman_bucy import KalmanResult
+from .systems import StateSpace, as_system
 
 __all__ = ["discrete_kalman_filter"]
 
@@ -56,11 +57,11 @@ def _sampled_data(sys: StateSpace, y, u):
 def _weights(sys: StateSpace, Q, R, P0, x0):
     n, p = sys.n, sys.p
     state = f"one row and column per state, n = {n}"
-    Q = _covariance(Q, "Q", n, definite=False, why=state + " (covariance of w(k))")
-    R = _covariance(R, "R", p, definite=True,
+    Q = as_covariance(Q, "Q", n, definite=False, why=state + " (covariance of w(k))")
+    R = as_covariance(R, "R", p, definite=True,
                     why=f"one row and column per output, p = {p} (covariance of v(k))")
-    P0 = _covariance(P0, "P0", n, definite=False, why=state + " (covariance of x(0))")
-    return Q, R, P0, _initial_estimate(x0, n)
+    P0 = as_covariance(P0, "P0", n, definite=False, why=state + " (covariance of x(0))")
+    return Q, R, P0, initial_estimate(x0, n)
 
 
 def _check_finite(k: int, dt: float, x: np.ndarray, P: np.ndarray) -> None:

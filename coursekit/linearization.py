@@ -12,6 +12,11 @@
 
 The linear model describes the deviations dx = x - x*, du = u - u* (3.61),
 (3.77): d(dx)/dt = A dx + B du (3.79).
+
+Shared within coursekit (not in ``ck.*``): the numerical derivatives
+`numerical_jacobian`, `perturbed_states` and `difference_quotients` (used by
+`simulate`'s implicit solvers and the EKF), and the argument helpers
+`function_name`, `input_size_explained`, `sympy_column` (used by `equilibria`).
 """
 
 from __future__ import annotations
@@ -22,14 +27,14 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import _is_complex, as_dt, as_flag, as_scalar, as_system, as_vector, foreign_library
-from .diagnostics import call_user, warn_accuracy
-from .systems import NonlinearSystem, StateSpace, _raw_field
+from ._validation import is_complex, as_dt, as_flag, as_scalar, as_vector, call_user, foreign_library
+from .diagnostics import warn_accuracy
+from .systems import NonlinearSystem, StateSpace, as_system, raw_field
 
 __all__ = ["linearize", "symbolic_jacobian", "linearize_symbolic"]
 
 
-def _function_name(func: Callable, role: str = "f") -> str:
+def function_name(func: Callable, role: str = "f") -> str:
     """How error messages name a user function: its role, and its own name if it has one."""
     own = getattr(func, "__name__", "")
     return f"{role} ({own})" if own and own not in (role, "<lambda>") else role
@@ -46,7 +51,7 @@ def _vector_field(f, x_eq, u_eq):
             u_eq, "u_eq", size=m, why=f"one per input of the system with m={m}")
         if m == 0:
             u = np.zeros(0)
-        return _raw_field(f), _function_name(getattr(f, "_f", f.f)), x, u, n, m, dt
+        return raw_field(f), function_name(getattr(f, "_f", f.f)), x, u, n, m, dt
     if not callable(f):
         raise ValueError(
             f"f must be a NonlinearSystem or a function f(x, u) returning dx/dt: received "
@@ -54,7 +59,7 @@ def _vector_field(f, x_eq, u_eq):
         )
     x = as_vector(x_eq, "x_eq")
     u = np.zeros(0) if u_eq is None else as_vector(u_eq, "u_eq")
-    return f, _function_name(f), x, u, x.size, u.size, None
+    return f, function_name(f), x, u, x.size, u.size, None
 
 
 def _central(g: Callable, z: np.ndarray, h: np.ndarray, k: int) -> np.ndarray:
@@ -75,27 +80,27 @@ def _filter_steps(z: np.ndarray) -> np.ndarray:
 
 @cache
 def _signs(n: int) -> np.ndarray:
-    """[I, -I, 0], shape (n, 2n + 1), read-only: the pattern of `_perturbed`."""
+    """[I, -I, 0], shape (n, 2n + 1), read-only: the pattern of `perturbed_states`."""
     E = np.hstack([np.eye(n), -np.eye(n), np.zeros((n, 1))])
     E.flags.writeable = False
     return E
 
 
-def _perturbed(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def perturbed_states(z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """(Z, h): the states of the unrefined central difference as the columns of Z (n, 2n + 1).
 
     Column k is z + h_k e_k, column n + k is z - h_k e_k (the numbers
-    `_jacobian(g, z, refine=False)` evaluates g at, one call each) and the
+    `numerical_jacobian(g, z, refine=False)` evaluates g at, one call each) and the
     last column is z itself; h = `_filter_steps(z)`.
     """
     h = _filter_steps(z)
     return z[:, None] + _signs(z.size) * h[:, None], h
 
 
-def _quotients(G: np.ndarray, h: np.ndarray) -> np.ndarray:
-    """The Jacobian (q, n) from G (q, 2n + 1), g evaluated on the columns of `_perturbed`.
+def difference_quotients(G: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """The Jacobian (q, n) from G (q, 2n + 1), g evaluated on the columns of `perturbed_states`.
 
-    Column k is (g(z + h_k e_k) - g(z - h_k e_k)) / (2 h_k), as in `_jacobian(g,
+    Column k is (g(z + h_k e_k) - g(z - h_k e_k)) / (2 h_k), as in `numerical_jacobian(g,
     z, refine=False)`, from one call of g on a batch instead of 2n calls.
     """
     n = h.size
@@ -303,7 +308,7 @@ def _ridders(g: Callable, z: np.ndarray, q: int, scale: float = 1.0) -> tuple[np
     return J, err
 
 
-def _jacobian(g: Callable, z: np.ndarray, *, refine: bool = True) -> np.ndarray:
+def numerical_jacobian(g: Callable, z: np.ndarray, *, refine: bool = True) -> np.ndarray:
     """Numerical Jacobian of g at z by central differences.
 
     ``refine=True`` is Ridders' method (`_ridders`, for `linearize`: about
@@ -418,7 +423,7 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     def checked(xx, uu, where):
         return np.ravel(call_user(func, (xx, uu), name, where=where))
 
-    with _input_size_explained(u_eq, u, "linearize"):
+    with input_size_explained(u_eq, u, "linearize"):
         f0 = checked(x, u, f"at x_eq = {x.tolist()}, u_eq = {u.tolist()}")
     if f0.size != n:
         raise ValueError(f"{name} returned {f0.size} numbers at x_eq; expected {n} (one per state).")
@@ -435,7 +440,7 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
 
 
 @contextmanager
-def _input_size_explained(u_eq, u: np.ndarray, task: str):
+def input_size_explained(u_eq, u: np.ndarray, task: str):
     """Turn an IndexError of the user's f at the first call into "u_eq is missing / too short".
 
     f(x, u) that reads u[0] fails with the student's own IndexError when u_eq
@@ -476,8 +481,8 @@ def symbolic_jacobian(f, variables):
     `f` is a list (or sympy Matrix) of expressions, `variables` a list of symbols.
     """
     import sympy as sp
-    F = _sympy_column(f, "f")
-    V = _sympy_column(variables, "variables")
+    F = sympy_column(f, "f")
+    V = sympy_column(variables, "variables")
     if not all(isinstance(v, sp.Symbol) for v in V):
         raise ValueError(f"variables must be sympy symbols: received {list(V)!r}.")
     return F.jacobian(V)
@@ -492,8 +497,8 @@ def linearize_symbolic(f, x, u=None, x_eq=None, u_eq=None):
     simplified; without `u` B has zero columns.
     """
     import sympy as sp
-    X = _sympy_column(x, "x")
-    U = _sympy_column(u, "u", allow_empty=True) if u is not None else sp.zeros(0, 1)
+    X = sympy_column(x, "x")
+    U = sympy_column(u, "u", allow_empty=True) if u is not None else sp.zeros(0, 1)
     if x_eq is None:
         raise ValueError("x_eq is missing: pass the equilibrium as a list, e.g. [sp.pi, 0].")
     subs = dict(zip(X, _values(x_eq, len(X), "x_eq")))
@@ -506,7 +511,7 @@ def linearize_symbolic(f, x, u=None, x_eq=None, u_eq=None):
     return A, B
 
 
-def _sympy_column(values, name: str, *, allow_empty: bool = False):
+def sympy_column(values, name: str, *, allow_empty: bool = False):
     """`values` (a list or sympy Matrix of expressions) as a sympy column; text and (unless
     `allow_empty`) an empty list raise ValueError naming `name`."""
     import sympy as sp
@@ -529,7 +534,7 @@ def _sympy_column(values, name: str, *, allow_empty: bool = False):
 
 def _values(values, size: int, name: str) -> list:
     vals = list(values) if isinstance(values, (list, tuple)) else list(np.ravel(values))
-    if _is_complex(vals):
+    if is_complex(vals):
         raise ValueError(f"{name} must contain real values: received {vals!r} with complex entries; "
                          "an equilibrium of a real system is real.")
     if len(vals) != size:

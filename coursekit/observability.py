@@ -12,6 +12,8 @@ of repeating them.
   units by duality with `is_controllable`;
 * `ocf_transform(A, C)` returns T with z = T x in OCF (4.31)-(4.32);
 * `place_observer(A, C, poles)` returns L with eig(A - L C) = poles.
+
+Shared within coursekit (not in ``ck.*``): `as_obs_pair` checks (A, C) for `kalman_gain`.
 """
 
 from __future__ import annotations
@@ -21,12 +23,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import as_matrix, as_poles, as_square
-from .controllability import (_canonical_transform, _check_tol, _controllability, _ctrb,
-                              _marginal_note, _Staircase)
-from .placement import _gain, _PoleMatch, _require_finite, _warn_if_missed, check_size, poly_from_roots
+from .diagnostics import NotObservableError
+from .controllability import (canonical_transform, check_tol, unit_free_staircase, ctrb_unchecked,
+                              marginal_note, Staircase)
+from .placement import place_gain, PoleMatch, require_finite, warn_if_missed, check_size, poly_from_roots
 
 __all__ = [
-    "NotObservableError",
     "obsv",
     "obsv_singular_values",
     "is_observable",
@@ -37,11 +39,7 @@ __all__ = [
 ]
 
 
-class NotObservableError(ValueError):
-    """Raised when an algorithm needs an observable pair (A, C) and it is not."""
-
-
-def _obs_pair(A, C):
+def as_obs_pair(A, C):
     """Validate (A, C): A square (n, n), C of shape (p, n); a 1-D C is one row."""
     A = as_square(A, "A")
     n = A.shape[0]
@@ -54,7 +52,7 @@ def _obs_pair(A, C):
 
 def _obsv(A: np.ndarray, C: np.ndarray) -> np.ndarray:
     # duality: Wo = [C; CA; ...; CA^(n-1)] = Wc(A^T, C^T)^T
-    return _ctrb(A.T, C.T).T
+    return ctrb_unchecked(A.T, C.T).T
 
 
 def obsv(A, C) -> np.ndarray:
@@ -63,7 +61,7 @@ def obsv(A, C) -> np.ndarray:
     With one output it is the n x n matrix of (4.12); with p outputs the
     blocks C A^i have p rows each.
     """
-    A, C = _obs_pair(A, C)
+    A, C = as_obs_pair(A, C)
     return _obsv(A, C)
 
 
@@ -83,18 +81,18 @@ def is_observable(A, C, *, tol: float | None = None) -> bool:
     for several outputs, where Wo is not square and the notes'
     ``det(Wo) != 0`` test does not apply. `tol` as in `is_controllable`.
     """
-    A, C = _obs_pair(A, C)
-    return _controllability(A.T, C.T, _check_tol(tol)).rank == A.shape[0]
+    A, C = as_obs_pair(A, C)
+    return unit_free_staircase(A.T, C.T, check_tol(tol)).rank == A.shape[0]
 
 
 def require_observable(A: np.ndarray, C: np.ndarray, *, purpose: str,
-                       tol: float | None = None) -> _Staircase:
+                       tol: float | None = None) -> Staircase:
     """Return the staircase of the dual pair (A^T, C^T), or raise NotObservableError.
 
     The verdict is `is_observable`'s; the message says how many directions
     leave no trace in y, what to do, and whether the decision was marginal.
     """
-    v = _controllability(A.T, C.T, _check_tol(tol))
+    v = unit_free_staircase(A.T, C.T, check_tol(tol))
     n, r = A.shape[0], v.rank
     if r < n:
         raise NotObservableError(
@@ -103,7 +101,7 @@ def require_observable(A: np.ndarray, C: np.ndarray, *, purpose: str,
             "without units by an orthogonal staircase of the balanced dual pair (A^T, C^T); "
             f"see is_observable). {n - r} direction(s) of the state leave no trace in y: "
             "measure another combination of the states (add a row to C), or check the "
-            "entries of A and C." + _marginal_note(v, "nearly observable")
+            "entries of A and C." + marginal_note(v, "nearly observable")
         )
     return v
 
@@ -135,18 +133,18 @@ def ocf_transform(A, C) -> np.ndarray:
     Single output only (C of shape (1, n)). Raises `NotObservableError` when
     (A, C) is not observable: an unobservable system has no OCF.
     """
-    A, C = _obs_pair(A, C)
+    A, C = as_obs_pair(A, C)
     _single_output(C, "the OCF")
     # duality: V = T^{-1} has columns V_i = (T_dual,i)^T, T_dual the CCF transform of (A^T, C^T)
-    T_dual = _canonical_transform(A.T, C.T, form="observability canonical form (4.31)",
-                                  purpose="a transform to the observability canonical form",
-                                  equations="C T^-1 = e_n^T and the structure of T A T^-1",
-                                  require=_require_observable_dual)
+    T_dual = canonical_transform(A.T, C.T, form="observability canonical form (4.31)",
+                                 purpose="a transform to the observability canonical form",
+                                 equations="C T^-1 = e_n^T and the structure of T A T^-1",
+                                 require=_require_observable_dual)
     # (4.49): T = V^{-1}
     return np.linalg.inv(T_dual.T)
 
 
-def _require_observable_dual(At: np.ndarray, Ct: np.ndarray, *, purpose: str) -> _Staircase:
+def _require_observable_dual(At: np.ndarray, Ct: np.ndarray, *, purpose: str) -> Staircase:
     """`require_observable` called with the dual pair (A^T, C^T)."""
     return require_observable(At.T, Ct.T, purpose=purpose)
 
@@ -185,7 +183,7 @@ def place_observer_details(A, C, poles) -> ObserverDetails:
     Like `place_observer`, it checks eig(A - L C) against `poles` and issues an
     `AccuracyWarning` when they miss.
     """
-    A, C = _obs_pair(A, C)
+    A, C = as_obs_pair(A, C)
     n = A.shape[0]
     poles = as_poles(poles, "poles", count=n)
     T = ocf_transform(A, C)
@@ -196,7 +194,7 @@ def place_observer_details(A, C, poles) -> ObserverDetails:
     p = poly_from_roots(poles)            # desired p(s) of the error dynamics
     L_ocf = (p - a).reshape(n, 1)         # (4.46): l_i = p_{i-1} - a_{i-1}
     L = V @ L_ocf                         # (4.60): L = V L~
-    _warn_if_missed(_PoleMatch(A - L @ C, poles, A), _OBSERVER)
+    warn_if_missed(PoleMatch(A - L @ C, poles, A), _OBSERVER)
     return ObserverDetails(T=T, V=V, A_ocf=A_ocf, C_ocf=C_ocf, a=a, p=p, L_ocf=L_ocf, L=L)
 
 
@@ -240,13 +238,13 @@ def place_observer(A, C, poles) -> np.ndarray:
     Raises `NotObservableError` if (A, C) is not observable and `ValueError`
     for a wrong number of poles or a complex pole without its conjugate.
     """
-    A, C = _obs_pair(A, C)
+    A, C = as_obs_pair(A, C)
     poles = as_poles(poles, "poles", count=A.shape[0])
     check_size(A.shape[0], C.shape[0], f"C has {C.shape[0]} rows")
     require_observable(A, C, purpose="placing every pole of the estimation error dynamics")
     # (4.84): L^T = place(A^T, C^T, P) in MATLAB's sign, i.e. L = -K^T in the course's
-    K, _ = _gain(A.T, C.T, poles)
+    K, _ = place_gain(A.T, C.T, poles)
     L = -K.T
-    _require_finite(L, _OBSERVER)
-    _warn_if_missed(_PoleMatch(A - L @ C, poles, A), _OBSERVER)
+    require_finite(L, _OBSERVER)
+    warn_if_missed(PoleMatch(A - L @ C, poles, A), _OBSERVER)
     return L

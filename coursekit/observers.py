@@ -21,8 +21,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_matrix, as_series, as_system
-from .systems import StateSpace
+from ._validation import as_matrix, as_series
+from .systems import StateSpace, as_system
 
 __all__ = [
     "observer_system",

@@ -5,7 +5,11 @@ MATLAB, SciPy and python-control use u = -K x, so coursekit's K is minus theirs.
 
 Every gain is checked after it is computed: the eigenvalues of the closed
 loop are matched to the requested poles, and an `AccuracyWarning` says by how
-much they miss when they miss by more than the tolerance of `_PoleMatch`.
+much they miss when they miss by more than the tolerance of `PoleMatch`.
+
+Shared within coursekit (not in ``ck.*``): `place_observer` places the poles of
+A - L C as those of the dual A^T + C^T K (L = -K^T), with the same `place_gain`,
+`PoleMatch`, `warn_if_missed`, `require_finite` and `check_size`.
 """
 
 from __future__ import annotations
@@ -16,8 +20,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import as_poles
-from .controllability import NotControllableError, _pair, _rank, ccf_transform, require_controllable
-from .diagnostics import warn_accuracy
+from .controllability import as_pair, numerical_rank, ccf_transform, require_controllable
+from .diagnostics import NotControllableError, warn_accuracy
 
 __all__ = ["place", "place_details", "PlacementDetails", "poly_from_roots"]
 
@@ -85,7 +89,7 @@ def place_details(A, B, poles) -> PlacementDetails:
     accurate for larger or badly scaled systems. Like `place`, it checks
     eig(A + B K) against `poles` and issues an `AccuracyWarning` when they miss.
     """
-    A, B = _pair(A, B)
+    A, B = as_pair(A, B)
     n = A.shape[0]
     poles = as_poles(poles, "poles", count=n)
     T = ccf_transform(A, B)
@@ -94,7 +98,7 @@ def place_details(A, B, poles) -> PlacementDetails:
     p = poly_from_roots(poles)     # desired p(s) (3.43)
     K_ccf = (a - p).reshape(1, n)  # (3.46): k~_i = -p_{i-1} + a~_{i-1}
     K = K_ccf @ T                  # (3.47): u = K~ T x
-    _warn_if_missed(_PoleMatch(A + B @ K, poles, A), _FEEDBACK)
+    warn_if_missed(PoleMatch(A + B @ K, poles, A), _FEEDBACK)
     return PlacementDetails(T=T, A_ccf=A_ccf, a=a, p=p, K_ccf=K_ccf, K=K)
 
 
@@ -146,13 +150,13 @@ def place(A, B, poles) -> np.ndarray:
     A request far below A's own scale (poles of size 1 for an A of 1e200)
     misses by more than the poles' size and gets the `AccuracyWarning`.
     """
-    A, B = _pair(A, B)
+    A, B = as_pair(A, B)
     poles = as_poles(poles, "poles", count=A.shape[0])
     check_size(A.shape[0], B.shape[1], f"B has {B.shape[1]} columns")
     require_controllable(A, B, purpose="placing every closed-loop pole")
-    K, match = _gain(A, B, poles)
-    _require_finite(K, _FEEDBACK)
-    _warn_if_missed(match, _FEEDBACK)
+    K, match = place_gain(A, B, poles)
+    require_finite(K, _FEEDBACK)
+    warn_if_missed(match, _FEEDBACK)
     return K
 
 
@@ -171,7 +175,7 @@ def check_size(n: int, m: int, channels: str) -> None:
         )
 
 
-def _require_finite(G: np.ndarray, words: dict) -> None:
+def require_finite(G: np.ndarray, words: dict) -> None:
     """Raise when a gain overflowed: no double-precision gain places these poles."""
     if not np.all(np.isfinite(G)):
         raise ValueError(
@@ -183,28 +187,28 @@ def _require_finite(G: np.ndarray, words: dict) -> None:
 # ---------------------------------------------------------------------------------------------
 # The methods (called after the controllability check)
 
-def _gain(A: np.ndarray, B: np.ndarray, poles: np.ndarray):
-    """K with eig(A + B K) = poles for a controllable (A, B), and its `_PoleMatch`."""
+def place_gain(A: np.ndarray, B: np.ndarray, poles: np.ndarray):
+    """K with eig(A + B K) = poles for a controllable (A, B), and its `PoleMatch`."""
     if B.shape[1] == 1:
         K = _single_input(A, B[:, 0], poles)
-        return K, _PoleMatch(A + B @ K, poles, A)
-    r = _rank(B, None)
+        return K, PoleMatch(A + B @ K, poles, A)
+    r = numerical_rank(B, None)
     _, _, Vt = np.linalg.svd(B)
     V_r = Vt[:r].T                                   # B V = [B_r, 0]: B_r = B V_r has full rank r
     B_r = B @ V_r if r < B.shape[1] else B
     if r == 1:
         K = V_r @ _single_input(A, B_r[:, 0], poles)
-        return K, _PoleMatch(A + B @ K, poles, A)
+        return K, PoleMatch(A + B @ K, poles, A)
     lift = (lambda K_r: V_r @ K_r) if r < B.shape[1] else (lambda K_r: K_r)
     tried = []
     robust = _robust(A, B_r, poles)
     if robust is not None:
-        tried.append((lift(robust), _PoleMatch(A + B @ lift(robust), poles, A)))
+        tried.append((lift(robust), PoleMatch(A + B @ lift(robust), poles, A)))
         if tried[-1][1].ratio <= 1.0:
             return tried[-1]
     try:
         K = lift(_heymann(A, B_r, poles)[0])
-        tried.append((K, _PoleMatch(A + B @ K, poles, A)))
+        tried.append((K, PoleMatch(A + B @ K, poles, A)))
     except NotControllableError:
         if not tried:
             raise
@@ -246,7 +250,7 @@ def _heymann(A: np.ndarray, B_r: np.ndarray, poles: np.ndarray, tries: int = 6):
         except NotControllableError:
             continue
         K = (K0 + np.outer(g, k)) / d                 # back to x: K = K_b D^-1
-        match = _PoleMatch(A + B_r @ K, poles, A)
+        match = PoleMatch(A + B_r @ K, poles, A)
         if best is None or match.ratio < best[1].ratio:
             best = (K, match)
         if match.ratio <= 1.0:
@@ -339,7 +343,7 @@ def _groups(poles: np.ndarray, rtol: float = 1e-9):
     return labels, np.bincount(labels, minlength=poles.size)
 
 
-class _PoleMatch:
+class PoleMatch:
     """eig(M) matched to the requested poles, with the largest error against the tolerance.
 
     The scale is the largest requested or achieved pole magnitude, or the
@@ -407,7 +411,7 @@ _FEEDBACK = {
 }
 
 
-def _warn_if_missed(match: _PoleMatch, words: dict, stacklevel: int = 4) -> None:
+def warn_if_missed(match: PoleMatch, words: dict, stacklevel: int = 4) -> None:
     """Issue an AccuracyWarning when `match` exceeds its tolerance, saying by how much."""
     if match.ratio <= 1.0:
         return

@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_scalar, as_system, as_vector
-from .systems import NonlinearSystem, StateSpace
+from ._validation import as_scalar, as_vector
+from .systems import NonlinearSystem, StateSpace, as_system
 
 __all__ = ["ode_to_ss", "difference_to_ss", "euler_discretize"]
 

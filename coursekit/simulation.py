@@ -33,12 +33,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import (as_matrix, as_scalar, as_series, as_square, as_system, as_time_grid, as_vector,
-                          is_uniform)
-from .diagnostics import UserFunctionError, call_user
-from .systems import NonlinearSystem, StateSpace, _checked_call, _raw_field
+from ._validation import (as_matrix, as_scalar, as_series, as_square, as_time_grid, as_vector, call_user,
+                          checked_call, is_uniform)
+from .diagnostics import SimulationError, UserFunctionError
+from .systems import NonlinearSystem, StateSpace, as_system, raw_field
 
-__all__ = ["simulate", "simulate_batch", "SimulationResult", "SimulationError", "lti_step_matrices"]
+__all__ = ["simulate", "simulate_batch", "SimulationResult", "lti_step_matrices"]
 
 # the method names scipy.integrate.solve_ivp accepts
 _METHODS = ("RK45", "RK23", "DOP853", "Radau", "BDF", "LSODA")
@@ -47,17 +47,6 @@ _RTOL_MIN = 100 * np.finfo(float).eps
 # beyond sqrt(largest float) ~ 1.3e154 the square of a state entry overflows: any model with
 # a quadratic term returns inf there, which is the state's growth, not a bug in the model
 _HUGE = float(np.sqrt(np.finfo(float).max))
-
-
-class SimulationError(ValueError, RuntimeError):
-    """The simulation cannot reach the end of the time grid.
-
-    Raised when the state overflows the float range (about 1.8e308: an
-    unstable system simulated for too long, or a solution with a finite
-    escape time) and when the ODE solver gives up. The message says at
-    which time, why, and what to try. It is both a ValueError and a
-    RuntimeError, so either catches it.
-    """
 
 
 @dataclass(repr=False)
@@ -264,7 +253,7 @@ def _check_batch(model, t0: float, X: np.ndarray) -> None:
         raise ValueError(f"f cannot be evaluated on a batch of states (shape {X.shape}): {err}; "
                          "write f with numpy operations on the rows x[0], x[1], ... "
                          "or use simulate for one initial state at a time.") from err
-    if not _agrees_column_by_column(sys.f, X, U, F):
+    if not agrees_column_by_column(sys.f, X, U, F):
         raise ValueError("f gives different results on a batch of states than one state at a time; "
                          "use simulate for one initial state at a time.")
 
@@ -278,8 +267,8 @@ def _batch_input(u, tk: float, X: np.ndarray, m: int) -> np.ndarray:
     return U
 
 
-def _agrees_column_by_column(fun, X: np.ndarray, U: np.ndarray, batch: np.ndarray) -> bool:
-    """True when `batch`, fun's answer for the states X and inputs U as columns, holds
+def agrees_column_by_column(fun, X: np.ndarray, U: np.ndarray, batch: np.ndarray) -> bool:
+    """(Shared with the EKF.) True when `batch`, fun's answer for the states X and inputs U as columns, holds
     fun(X[:, j], U[:, j]) in column j for every j (within 1e-12)."""
     single = np.column_stack([np.ravel(fun(X[:, j], U[:, j])) for j in range(X.shape[1])])
     return batch.size == single.size and np.allclose(batch.reshape(single.shape), single,
@@ -355,7 +344,7 @@ class _Model:
 
     def __init__(self, sys, u_fun, u_user=None):
         self.sys, self.u_fun, self.u_user = sys, u_fun, u_user
-        self.f = _raw_field(sys)
+        self.f = raw_field(sys)
 
     def input(self, tk, xk) -> np.ndarray:
         """u(t, x), finite."""
@@ -406,8 +395,8 @@ class _Model:
         if self.u_user is None:
             return self.u_fun(tk, xk)
         m = self.sys.m
-        return _checked_call(self.u_user, (tk, xk), "u", size=m, where=where,
-                             what=f"the {m} input(s) at time t and state x")
+        return checked_call(self.u_user, (tk, xk), "u", size=m, where=where,
+                            what=f"the {m} input(s) at time t and state x")
 
     def fail_batch(self, tk, X, err=None):
         """`fail` for a batch X (n, k): u once on the batch, then f trajectory by trajectory."""
@@ -521,8 +510,8 @@ def _input(sys, t: np.ndarray, u, x0: np.ndarray):
         zero = None if isinstance(sys, StateSpace) else (lambda tk, xk: np.zeros(m))
         return np.zeros((t.size, m)), zero, None
     if callable(u):
-        _checked_call(u, (t[0], x0), "u", size=m, where=_where(t[0], x0),
-                      what=f"the {m} input(s) at time t and state x")
+        checked_call(u, (t[0], x0), "u", size=m, where=_where(t[0], x0),
+                     what=f"the {m} input(s) at time t and state x")
 
         def u_fun(tk, xk):
             value = np.asarray(u(tk, xk), dtype=float).reshape(-1)
@@ -771,10 +760,10 @@ def _check_explicit_work(field, t: np.ndarray, x0: np.ndarray, options: dict) ->
     """
     if options["method"] not in _EXPLICIT:
         return
-    from .linearization import _jacobian
+    from .linearization import numerical_jacobian
     try:
         with np.errstate(all="ignore"):
-            J = _jacobian(field, x0, refine=False)
+            J = numerical_jacobian(field, x0, refine=False)
             rate = float(np.abs(np.linalg.eigvals(J)).max())
     except Exception:  # f fails near x0: the guarded integration reports it
         return

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_dt, as_scalar, as_square, as_system, foreign_library
-from .systems import StateSpace
+from ._validation import as_dt, as_square, foreign_library
+from .systems import StateSpace, as_system
 
 __all__ = ["is_stable", "plot_poles", "format_poles"]
 

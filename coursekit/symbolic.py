@@ -40,10 +40,10 @@ def _check_real(expr, name: str) -> None:
 
 def _sym_matrix(value, name: str):
     import sympy as sp
-    from ._validation import _is_complex, _is_text
-    if value is None or _is_text(value):
+    from ._validation import is_complex, is_text
+    if value is None or is_text(value):
         raise ValueError(f"{name} must be a matrix (nested list or sympy Matrix): received {value!r}.")
-    if _is_complex(value):
+    if is_complex(value):
         raise ValueError(f"{name} must be real: received complex entries; pass the real matrix "
                          "(complex numbers are only accepted as poles).")
     dims = _dimensions(value)
@@ -252,8 +252,8 @@ def _planar(car: bool):
 def _sym_parameter(value, key: str):
     """A parameter value for `symbolic_flat_maps`: a real number or a sympy expression."""
     import sympy as sp
-    from ._validation import _is_complex, _is_text
-    if value is None or _is_text(value) or _is_complex(value):
+    from ._validation import is_complex, is_text
+    if value is None or is_text(value) or is_complex(value):
         raise ValueError(f"{key} must be a real number or a sympy expression: received {value!r}.")
     try:
         expr = sp.sympify(value)

@@ -5,52 +5,24 @@
 `NonlinearSystem` holds the vector field f of (1.32) and the output map h
 of (1.33). Both expose `f(x, u)` and `h(x, u)` so that `simulate` treats
 them alike.
+
+Shared within coursekit (not in ``ck.*``): `as_system` (every public function
+that takes a system calls it: python-control and scipy.signal systems are
+converted through the bridges), and `raw_field` / `raw_output`, the model's own
+f and h for hot loops.
 """
 
 from __future__ import annotations
 
+import sys as _sys
 from typing import Callable
 
 import numpy as np
 
-from ._validation import as_dt, as_matrix, as_scalar, as_square, check_function_output
-from .diagnostics import UserFunctionError, call_user, call_user_fast
+from ._validation import (BRIDGES, as_dt, as_matrix, as_scalar, as_square, call_user, call_user_fast, checked_call,
+                          float_array, foreign_library, type_name)
 
 __all__ = ["StateSpace", "NonlinearSystem"]
-
-
-def _check_dt(dt, name: str = "dt") -> float | None:
-    return as_dt(dt, name)
-
-
-def _checked_call(func: Callable, args: tuple, name: str, *, size: int, what: str,
-                  where: str = "") -> np.ndarray:
-    """Call a user function once: an exception, None or NaN/inf is explained by
-    `call_user` (naming `name` and `where`), a wrong return shape by
-    `check_function_output`'s rule; returns the value as a flat float array."""
-    value = call_user(func, args, name, where=where)
-    try:
-        return check_function_output(lambda *_: value, args, name, size=size, what=what)
-    except ValueError as err:
-        if not where:
-            raise
-        raise UserFunctionError(f"{err} This happened {where}.") from None
-
-
-def _float_array(value, name: str) -> np.ndarray:
-    """value as a float array; None, complex or non-numeric values raise ValueError naming `name`."""
-    if value is None:
-        raise ValueError(f"{name} is None: expected an array of real numbers.")
-    arr = np.asarray(value)
-    if arr.dtype.kind == "f":
-        return arr
-    if arr.dtype.kind == "c":
-        raise ValueError(f"{name} must contain real numbers: received complex entries.")
-    try:
-        return arr.astype(float, copy=False)
-    except (TypeError, ValueError) as err:
-        raise ValueError(f"{name} must be an array of real numbers: received {type(value).__name__} "
-                         f"({err}).") from None
 
 
 def _finite(arr: np.ndarray, name: str) -> np.ndarray:
@@ -69,14 +41,14 @@ def _state_and_input(x, u, n: int, m: int) -> tuple[np.ndarray, np.ndarray]:
     it would otherwise broadcast into an (n, n) result). NaN/inf entries and
     u = None raise ValueError too; with m = 0, u may be None or empty.
     """
-    x = _finite(_float_array(x, "x"), "x")
+    x = _finite(float_array(x, "x"), "x")
     if x.ndim == 0 or x.shape[0] != n:
         raise ValueError(f"x has shape {x.shape}: expected ({n},), one entry per state, or ({n}, k) "
                          "for a batch of k states as columns.")
     batch = x.shape[1:]
     if m == 0 and (u is None or np.size(u) == 0):
         return x, np.zeros((0,) + batch)
-    u = _finite(_float_array(u, "u"), "u")
+    u = _finite(float_array(u, "u"), "u")
     if x.ndim == 1 and u.size == m and u.ndim <= 1:
         return x, u.reshape(m)
     if u.shape != (m,) + batch:
@@ -97,7 +69,7 @@ def _evaluate(func: Callable, x: np.ndarray, u: np.ndarray, name: str) -> np.nda
     return call_user_fast(func, (x, u), name, where=lambda: _at(x, u))
 
 
-def _raw_field(sys) -> Callable:
+def raw_field(sys) -> Callable:
     """The model's own f(x, u), without the argument checks and the wrapping of `sys.f`.
 
     For hot loops (`simulate`) and for callers that call it through
@@ -110,8 +82,8 @@ def _raw_field(sys) -> Callable:
     return sys._f
 
 
-def _raw_output(sys) -> Callable:
-    """The model's own h(x, u) (C x + D u, or x when h is not given), as `_raw_field` for f."""
+def raw_output(sys) -> Callable:
+    """The model's own h(x, u) (C x + D u, or x when h is not given), as `raw_field` for f."""
     if isinstance(sys, StateSpace):
         C, D = sys.C, sys.D
         return lambda x, u: C @ x + D @ u
@@ -162,7 +134,7 @@ class StateSpace:
         self.D = np.zeros((p, m)) if D is None else as_matrix(
             D, "D", rows=p, cols=m, rows_why=f"one per output, since C has {p} rows",
             cols_why=f"one per input, since B has {m} columns")
-        self.dt = _check_dt(dt)
+        self.dt = as_dt(dt, "dt")
         self.name = str(name)
 
     @property
@@ -229,7 +201,7 @@ class StateSpace:
     def from_control(cls, sys) -> "StateSpace":
         """The python-control ``StateSpace`` `sys` as a coursekit StateSpace (dt=0 -> continuous)."""
         from .bridges import from_control
-        return from_control(sys)
+        return from_control(sys, cls)
 
     def to_control(self):
         """This system as a python-control ``StateSpace`` (continuous -> dt=0; needs `pip install control`)."""
@@ -240,7 +212,7 @@ class StateSpace:
     def from_scipy(cls, sys) -> "StateSpace":
         """The ``scipy.signal.StateSpace`` `sys` (continuous or discrete) as a coursekit StateSpace."""
         from .bridges import from_scipy
-        return from_scipy(sys)
+        return from_scipy(sys, cls)
 
     def to_scipy(self):
         """This system as a ``scipy.signal.StateSpace`` (continuous: dt=None; discrete: its dt)."""
@@ -283,7 +255,7 @@ class NonlinearSystem:
             raise ValueError(f"m must be >= 0: received {m!r}.")
         self._f = f
         self._h = h
-        self.dt = _check_dt(dt)
+        self.dt = as_dt(dt, "dt")
         self.name = str(name)
         self.params = dict(params or {})
 
@@ -311,10 +283,6 @@ class NonlinearSystem:
             return x.copy()
         return np.atleast_1d(_evaluate(self._h, x, u, "h"))
 
-    def output_size(self, x, u) -> int:
-        """Number of outputs, found by evaluating h once at (x, u)."""
-        return self.h(np.asarray(x, float), np.asarray(u, float)).size
-
     def check(self, x, u, *, where: str = "") -> None:
         """Call f, and h if given, once at (x, u) and explain what is wrong.
 
@@ -324,8 +292,8 @@ class NonlinearSystem:
         numbers.
         """
         word = "x(t+1)" if self.is_discrete else "dx/dt"
-        _checked_call(self._f, (x, u), "f", size=self.n, where=where,
-                      what=f"{word}, one entry per state for n={self.n}")
+        checked_call(self._f, (x, u), "f", size=self.n, where=where,
+                     what=f"{word}, one entry per state for n={self.n}")
         if self._h is not None:
             call_user(self._h, (x, u), "h", where=where)
 
@@ -335,3 +303,62 @@ class NonlinearSystem:
         extra = ", ".join(f"{k}={v:g}" if isinstance(v, (int, float)) else f"{k}={v!r}"
                           for k, v in self.params.items())
         return f"NonlinearSystem{title}: n={self.n}, m={self.m} ({kind})" + (f"; {extra}" if extra else "")
+
+
+_KINDS = {"any": "StateSpace or NonlinearSystem", "linear": "StateSpace", "nonlinear": "NonlinearSystem"}
+
+
+def _system_received(value) -> str:
+    """How a refused system argument is described: its time base, or its full type name."""
+    if isinstance(value, np.ndarray):
+        return f"a numpy array of shape {value.shape}"
+    if hasattr(value, "is_discrete") and type(value).__module__ == "coursekit.systems":
+        base, period = ("discrete", f" (dt={value.dt:g})") if value.is_discrete else ("continuous", "")
+        return f"a {base}-time {type(value).__name__}{period}"
+    return type_name(value)
+
+
+def as_system(value, name: str = "sys", *, kind: str = "any", time: str = "", hint: str = ""):
+    """Return `value` as a coursekit system, converting python-control and scipy.signal ones.
+
+    `kind` is "any" (StateSpace or NonlinearSystem), "linear" (StateSpace) or
+    "nonlinear"; `time` is "", "continuous" or "discrete". A ``control.StateSpace``
+    or ``scipy.signal.StateSpace`` (also ``scipy.signal.lti(A, B, C, D)``) goes through
+    the bridges `StateSpace.from_control` / `from_scipy` (the same matrices (1.24) and
+    time base); one whose time base is unspecified (``dt=True``, or python-control's
+    ``dt=None``) is refused, because reading it as dt = 1 or as continuous is the user's
+    choice, and so is choosing the realization of a transfer function: both messages
+    name the bridge. Anything else raises ValueError naming `name`, the wanted kind and
+    the full type name of what was received, followed by `hint`.
+    """
+    library = foreign_library(value)
+    if library is not None:
+        value = _from_foreign(value, name, library)
+    wanted = (StateSpace, NonlinearSystem) if kind == "any" else \
+        StateSpace if kind == "linear" else NonlinearSystem
+    right_time = not time or isinstance(value, (StateSpace, NonlinearSystem)) and \
+        value.is_discrete == (time == "discrete")
+    if not isinstance(value, wanted) or not right_time:
+        base = f"{time}-time " if time else ""
+        raise ValueError(f"{name} must be a {base}{_KINDS[kind]}: received {_system_received(value)}"
+                         + (f"; {hint}" if hint else "."))
+    return value
+
+
+def _from_foreign(value, name: str, library: str):
+    """The coursekit StateSpace of a python-control / scipy.signal state-space object (bridges)."""
+    from .bridges import realization_hint
+    module = _sys.modules["control" if library == "python-control" else "scipy.signal"]
+    bridge = BRIDGES[library]
+    if not isinstance(value, module.StateSpace):
+        raise ValueError(f"{name} must be a state-space system: received {type_name(value)}. "
+                         f"{realization_hint(value)} Then convert it with {bridge}(sys).")
+    dt = value.dt
+    if dt is True or (dt is None and library == "python-control"):
+        raise ValueError(
+            f"{name} is a {library} system whose time base is unspecified (dt={dt!r}): "
+            f"convert it with {bridge}(sys), which reads dt=True as a period of 1 and "
+            "python-control's dt=None as continuous time, or build it with dt=0 (continuous) "
+            "or the sampling period."
+        )
+    return getattr(StateSpace, bridge.split(".")[1])(value)

@@ -12,6 +12,9 @@
   z0 = T x0 to zT = T xT, and apply the feedforward input; the plan is
   checked by solving the plant exactly with it (`AccuracyWarning` if it
   does not land).
+
+Shared within coursekit (not in ``ck.*``): `input_time`, `plan_grid` and `PLAN_RTOL`,
+which `flatness` uses for its plans too.
 """
 
 from __future__ import annotations
@@ -23,9 +26,9 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_integer, as_scalar, as_series, as_time_grid, as_vector, time_grid
-from .controllability import _pair, ccf_transform, charpoly
-from .diagnostics import call_user, warn_accuracy
+from ._validation import as_integer, as_scalar, as_series, as_time_grid, as_vector, call_user, time_grid
+from .controllability import as_pair, ccf_transform, charpoly
+from .diagnostics import warn_accuracy
 
 __all__ = ["PolyTrajectory", "poly_trajectory", "feedforward", "OpenLoopPlan", "open_loop_control",
            "plot_plan"]
@@ -36,7 +39,7 @@ def _times(t, name: str = "t"):
     return as_vector(t, name), np.ndim(t) == 0
 
 
-def _input_time(t, horizon: float) -> float:
+def input_time(t, horizon: float) -> float:
     """One time for a plan's ``input(t, x)``, clipped to [0, T]; checked unless a finite float.
 
     An ODE solver passes a finite float at every step, so that case skips the checks.
@@ -45,7 +48,7 @@ def _input_time(t, horizon: float) -> float:
     return min(max(tt, 0.0), horizon)
 
 
-def _plan_grid(horizon: float, samples) -> np.ndarray:
+def plan_grid(horizon: float, samples) -> np.ndarray:
     """The plot grid of a plan: `samples` (>= 2) times on [0, T]."""
     return time_grid(horizon, samples, t_end_name="T", max_span=None)
 
@@ -407,7 +410,7 @@ class OpenLoopPlan:
 
     def input(self, t, x=None) -> np.ndarray:
         """``u(t, x)`` for `simulate`: the open-loop input ignores x (t is clipped to [0, T])."""
-        return np.array(self._input_derivatives(_input_time(t, self.horizon), 1))
+        return np.array(self._input_derivatives(input_time(t, self.horizon), 1))
 
     def _input_derivatives(self, t: float, count: int) -> list:
         """[u_d, u_d', ..., u_d^(count-1)] at one time t, in plain floats.
@@ -427,7 +430,7 @@ class OpenLoopPlan:
 
     def plot(self, samples: int = 301):
         """Figure of the planned states x(t) and the input u_d(t) on [0, T]; returns the figure."""
-        t = _plan_grid(self.horizon, samples)
+        t = plan_grid(self.horizon, samples)
         return plot_plan(t, self.x(t), self.ud(t).reshape(-1, 1),
                          title=f"open-loop plan (2.73) from x0 = {self.x0.tolist()} to xT = {self.xT.tolist()}")
 
@@ -466,7 +469,8 @@ def plot_plan(t, x, u, *, title: str):
 # the task's size max(|x0|, |xT|). Rounding moves them by ~1e-15 of the largest state on the
 # way, so this holds while the plan stays within ~1e8 times the task's size (the notes'
 # examples: < 10; random 8-state systems with T = 1: ~1e6); 12 random states pass 1e10.
-_PLAN_RTOL = 1e-6
+#: relative tolerance of an open-loop plan's boundary check (shared with `flatness`)
+PLAN_RTOL = 1e-6
 
 
 def _landing(plan: OpenLoopPlan) -> np.ndarray:
@@ -503,14 +507,14 @@ def _check_plan(plan: OpenLoopPlan) -> None:
     misses = {"the planned x(0)": np.abs(x_plan[0] - plan.x0).max(),
               "the planned x(T)": np.abs(x_plan[-1] - plan.xT).max(),
               "the simulated x(T)": np.abs(landed - plan.xT).max()}
-    allowed = _PLAN_RTOL * (task if task > 0 else 1.0)
+    allowed = PLAN_RTOL * (task if task > 0 else 1.0)
     worst = max(misses, key=lambda key: misses[key] if np.isfinite(misses[key]) else np.inf)
     if all(miss <= allowed for miss in misses.values()):
         return
     other = "; ".join(f"{key} misses by {miss:.3g}" for key, miss in misses.items() if key != worst)
     warn_accuracy(
         f"open_loop_control: the plan does not land. {worst} misses its target by "
-        f"{misses[worst]:.3g}, more than {_PLAN_RTOL:g} of the task's size {task:.3g} ({other}; "
+        f"{misses[worst]:.3g}, more than {PLAN_RTOL:g} of the task's size {task:.3g} ({other}; "
         f"simulated: x' = A x + B u_d solved exactly). On the way the planned state reaches "
         f"{peak:.3g} and the CCF transform z = T x (2.65) has condition number "
         f"{np.linalg.cond(plan.transform):.2g}, so rounding alone moves x(T) this much. "
@@ -546,7 +550,7 @@ def open_loop_control(A, B, x0, xT, T, *, smooth: int = 0) -> OpenLoopPlan:
 
     Single input only. Returns an `OpenLoopPlan`.
     """
-    A, B = _pair(A, B)
+    A, B = as_pair(A, B)
     n = A.shape[0]
     why = f"one per state of the {n}-state system"
     x0 = as_vector(x0, "x0", size=n, why=why)

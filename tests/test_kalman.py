@@ -1,5 +1,6 @@
 """kalman_gain, the Kalman-Bucy filter, the EKF and the noise helpers (section 4.7)."""
 
+import importlib
 import math
 import re
 
@@ -225,7 +226,7 @@ def test_noise_bad_inputs():
 def test_step_length_shortcut_is_the_exact_rule(n, seed, h_max):
     # the RK4 step is min(h_max, 0.5 / rate); the cheap bound may only skip the eigenvalues when
     # they could not shorten the step, so the result must equal the exact rule every time
-    from coursekit.kalman import _radius_bound, _riccati_rate, _step_length
+    from coursekit._filter_ode import _radius_bound, _riccati_rate, _step_length
     rng = np.random.default_rng(seed)
     A_, L_, C_ = rng.normal(size=(n, n)) * 10 ** rng.uniform(-1, 2), rng.normal(size=(n, 1)), rng.normal(size=(1, n))
     M = A_ - L_ @ C_
@@ -290,7 +291,7 @@ def _pendulum_one_state_at_a_time(x, u):
 
 
 def test_batch_check_accepts_models_and_refuses_what_it_must():
-    from coursekit.kalman import _accepts_batches
+    from coursekit.ekf import _accepts_batches
     x0, u0 = np.array([0.4, -1.3]), np.array([0.2])
     pend = ck.models.pendulum(d_theta=0.3)
     assert _accepts_batches(pend.f, x0, u0) and _accepts_batches(pend.h, x0, u0)
@@ -337,7 +338,7 @@ def test_filters_report_divergence_and_too_many_steps(monkeypatch):
     with pytest.raises(RuntimeError, match=r"the filter diverged at t=1.1"):
         ck.extended_kalman_filter(blow_up, np.linspace(0, 2, 21), None, np.zeros((21, 1)),
                                   [[0.0]], [[1.0]], [[1.0]], [1.0])
-    monkeypatch.setattr(ck.kalman, "_MAX_STEPS", 50)
+    monkeypatch.setattr(importlib.import_module("coursekit._filter_ode"), "_MAX_STEPS", 50)
     fast = {"Q": np.eye(2), "R": [[1e-8]], "P0": 1e3 * np.eye(2), "x0": [0, 0]}   # rate ~ 1e6 at first
     with pytest.raises(RuntimeError, match=r"needs more than 50 RK4 steps between two samples"):
         ck.kalman_bucy(ck.StateSpace(A, B, C), t, None, np.zeros((11, 1)), **fast)

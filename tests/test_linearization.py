@@ -104,9 +104,9 @@ def test_linearize_checks_tol():
 @example(n=4, q=1, seed=1704)
 @given(n=st.integers(1, 5), q=st.integers(1, 3), seed=st.integers(0, 10_000))
 def test_batched_central_differences_are_the_column_by_column_ones(n, q, seed):
-    # the EKF evaluates g once on the batch of _perturbed(z); _quotients must then give the
-    # numbers _jacobian(refine=False) gets from 2n separate calls, and the last column is z
-    from coursekit.linearization import _jacobian, _perturbed, _quotients
+    # the EKF evaluates g once on the batch of perturbed_states(z); difference_quotients must then give the
+    # numbers numerical_jacobian(refine=False) gets from 2n separate calls, and the last column is z
+    from coursekit.linearization import numerical_jacobian, perturbed_states, difference_quotients
     rng = np.random.default_rng(seed)
     z = rng.normal(size=n) * 10 ** rng.uniform(-2, 1.5, size=n)
     a, i, j = rng.normal(size=q), rng.integers(0, n, size=q), rng.integers(0, n, size=q)
@@ -114,7 +114,7 @@ def test_batched_central_differences_are_the_column_by_column_ones(n, q, seed):
     def g(x):  # polynomial rows: the same arithmetic on one state (n,) or on columns (n, k)
         return np.array([a[r] * x[i[r]] * x[j[r]] + x[j[r]] ** 3 - 2 * x[i[r]] for r in range(q)])
 
-    Z, h = _perturbed(z)
+    Z, h = perturbed_states(z)
     assert Z.shape == (n, 2 * n + 1)
     np.testing.assert_array_equal(Z[:, -1], z)
     for k in range(n):
@@ -123,14 +123,14 @@ def test_batched_central_differences_are_the_column_by_column_ones(n, q, seed):
         np.testing.assert_array_equal(Z[:, k], plus)
         np.testing.assert_array_equal(Z[:, n + k], minus)
     G = g(Z)
-    J = _quotients(G, h)
+    J = difference_quotients(G, h)
     # g on a batch may round differently from g on one state (numpy picks other loops for
     # 2-D arrays): each value may differ by a few ulps of its largest term (which may exceed the
     # value itself: seed 1704 cancels), and the quotient divides that by 2 h_k
     terms = np.array([np.abs(a[r] * Z[i[r]] * Z[j[r]]) + np.abs(Z[j[r]]) ** 3 + 2 * np.abs(Z[i[r]])
                       for r in range(q)])
     ulps = 8 * np.finfo(float).eps * terms.max(axis=1, keepdims=True)
-    np.testing.assert_array_less(np.abs(J - _jacobian(g, z, refine=False)), ulps / h + 1e-300)
+    np.testing.assert_array_less(np.abs(J - numerical_jacobian(g, z, refine=False)), ulps / h + 1e-300)
     exact = np.zeros((q, n))
     for r in range(q):
         exact[r, i[r]] += a[r] * z[j[r]] - 2

@@ -138,15 +138,15 @@ def test_twenty_poles_minus_one_to_minus_twenty_warn_for_feedback_and_observer()
 def test_the_check_catches_a_wrong_gain_and_only_a_wrong_one(monkeypatch, relative_error, warns):
     # a deliberately wrong K (poles moved by about relative_error) must warn; a K wrong only
     # at rounding level must not (the check is neither too lax nor too strict)
-    right = placement._gain
+    right = placement.place_gain
 
     def wrong(A, B, poles):
         K, _ = right(A, B, poles)
         K = K * (1 + relative_error)
-        return K, placement._PoleMatch(A + B @ K, poles)
+        return K, placement.PoleMatch(A + B @ K, poles)
 
-    monkeypatch.setattr(placement, "_gain", wrong)
-    monkeypatch.setattr(observability, "_gain", wrong)
+    monkeypatch.setattr(placement, "place_gain", wrong)
+    monkeypatch.setattr(observability, "place_gain", wrong)
     A, B = np.array([[0, 1.0], [-2, -3]]), np.array([[0], [1.0]])
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", ck.AccuracyWarning)

@@ -14,7 +14,7 @@ import numpy as np
 
 from .. import models
 from .._validation import as_integer, as_scalar, time_grid
-from ..kalman import kalman_gain, simulate_with_noise, white_noise
+from .. import kalman_gain, simulate_with_noise, white_noise
 from ..observability import place_observer
 from ..observers import observer_system
 from ..simulation import simulate
