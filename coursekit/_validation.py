@@ -79,10 +79,6 @@ def is_complex(value) -> bool:
     return False
 
 
-# the old private name, still imported by coursekit.exercises._feedback
-_is_complex = is_complex
-
-
 def is_text(value) -> bool:
     """True for a string, or a list/array of strings ("1.0" is text, not a number)."""
     if isinstance(value, (str, bytes)):

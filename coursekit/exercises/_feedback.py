@@ -26,7 +26,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from .._validation import _is_complex
+from .._validation import is_complex
 
 __all__ = [
     "CheckResult",
@@ -131,7 +131,7 @@ def _to_array(value, name: str, report: Report, *, dtype=float) -> np.ndarray | 
     if callable(value) and not _is_sympy(value):
         report.add(f"{name} is a function: call it and pass its result (numbers), not the function.")
         return None
-    if dtype is float and _is_complex(value):
+    if dtype is float and is_complex(value):
         report.add(f"{name} contains complex numbers: the answer is real. If the imaginary parts are "
                    "rounding noise from a computation (e.g. np.linalg.eig), pass np.real(...) of it; "
                    "otherwise recheck the computation.")
