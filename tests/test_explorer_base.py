@@ -62,23 +62,23 @@ def test_mimebundle_holds_the_widget_view_and_a_static_png():
 def test_moving_a_slider_refreshes_the_png_and_the_image_widget():
     exp = _explorer()
     widget = exp.widget
-    before = exp._png
+    before = exp.png
     exp.controls["a"].value = 2.5          # what each move of a dragged slider does
     assert exp.params == {"a": 2.5}
-    assert exp._png != before
-    assert widget.children[-1].png == exp._png
+    assert exp.png != before
+    assert widget.children[-1].png == exp.png
     np.testing.assert_allclose(exp.handles[1].get_ydata(), _compute(2.5)[1])
-    assert base64.b64decode(exp._repr_mimebundle_()["image/png"]) == exp._png
+    assert base64.b64decode(exp._repr_mimebundle_()["image/png"]) == exp.png
 
 
 def test_lecture_mode_enlarges_explorer_figures_and_off_restores_defaults():
-    default = _png_size(_explorer()._png)
+    default = _png_size(_explorer().png)
     before = {key: mpl.rcParams[key] for key in ck.LECTURE_STYLE}
     ck.lecture_mode()
     assert ck.is_lecture_mode()
     exp = _explorer()
     assert tuple(exp.fig.get_size_inches()) == pytest.approx(ck.LECTURE_STYLE["figure.figsize"])
-    big = _png_size(exp._png)
+    big = _png_size(exp.png)
     assert big[0] > default[0] and big[1] > default[1]
     fig, ax = ck.new_figure()
     line, = ax.plot([0, 1], [0, 1])
@@ -88,7 +88,7 @@ def test_lecture_mode_enlarges_explorer_figures_and_off_restores_defaults():
     ck.lecture_mode(False)
     assert not ck.is_lecture_mode()
     assert {key: mpl.rcParams[key] for key in ck.LECTURE_STYLE} == before
-    assert _png_size(_explorer()._png) == default
+    assert _png_size(_explorer().png) == default
 
 
 def test_lecture_mode_off_without_on_changes_nothing():

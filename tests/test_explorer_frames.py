@@ -175,11 +175,13 @@ def test_an_artist_drawn_over_a_moving_one_is_drawn_again_with_it():
     ax = fig.subplots()
     line, = ax.plot([0, 1], [0, 1], lw=8)
     legend = ax.legend(["a line"], loc="center")
+    ax.set_title("a title that no curve can reach")
     frames = FrameRenderer(fig)
     frames.frame()
     line.set_data([0, 1], [1, 0])
     frames.frame()
     assert legend.get_animated() and line.get_animated()
+    assert not ax.title.get_animated()                 # above the axes: it stays in the background
     line.set_data([0, 1], [0.5, 0.5])   # right under the legend
     np.testing.assert_array_equal(_pixels(frames.frame()), _pixels(_drawn_whole(fig)))
 

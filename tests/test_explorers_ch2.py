@@ -43,7 +43,7 @@ def test_bad_input():
 @pytest.mark.parametrize("factory", [ch2.planner_explorer, ch2.robot_planner_explorer])
 def test_explorers_build_and_update(factory):
     explorer = factory()
-    assert explorer.result is not None and explorer._png.startswith(b"\x89PNG")
+    assert explorer.result is not None and explorer.png.startswith(b"\x89PNG")
     before = explorer.result
     explorer.widget  # wires the sliders
     first = next(iter(explorer.controls.values()))

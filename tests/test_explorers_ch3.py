@@ -58,7 +58,7 @@ def test_integral_action_compute_removes_the_offset():
                                      ch3.integral_action_explorer])
 def test_explorers_build_label_and_refresh(factory):
     e = factory()
-    assert e.fig.axes and e._png.startswith(b"\x89PNG")
+    assert e.fig.axes and e.png.startswith(b"\x89PNG")
     for ax in e.fig.axes:
         assert ax.get_xlabel() and ax.get_ylabel() and ax.get_title()
     name, widget = next(iter(e.controls.items()))

@@ -55,5 +55,5 @@ def test_bad_parameters():
 def test_explorers_build_without_a_browser():
     for make in (observer_noise_explorer, kalman_tuning_explorer):
         e = make()
-        assert e.result is not None and e._png.startswith(b"\x89PNG")
+        assert e.result is not None and e.png.startswith(b"\x89PNG")
         assert e.fig.axes[0].get_title()

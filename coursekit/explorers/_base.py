@@ -21,6 +21,7 @@ static PNG, for pages without a kernel (GitHub, nbviewer, the website).
 from __future__ import annotations
 
 import base64
+import functools
 import html
 from typing import Any, Callable
 
@@ -179,6 +180,7 @@ class Explorer:
         self._check(title, controls, dict(compute=compute, draw=draw, update=update, readout=readout))
         self.title, self.controls = title, dict(controls)
         self._compute, self._update, self._readout = compute, update, readout
+        self._results = functools.lru_cache(maxsize=128)(lambda settings: compute(**dict(settings)))
         self.lecture = is_lecture_mode()
         self.fig = fit_margins(Figure(figsize=figsize or rcParams["figure.figsize"]))
         self.natural_dpi = float(self.fig.dpi)
@@ -192,7 +194,7 @@ class Explorer:
                              f"{type(error).__name__}: {error}; fix compute/update or the controls' "
                              "initial values") from error
         self.frames = FrameRenderer(self.fig)
-        self._png = self.frames.frame()
+        self.png = self.frames.frame()     # the figure as last drawn, at the size it is shown with
         self._widget = self._view = self._text = None
         # every callback on the kernel's main thread, whichever thread a message arrives on
         from ._home import HomeThread
@@ -222,16 +224,14 @@ class Explorer:
         return {name: w.value for name, w in self.controls.items()}
 
     @property
-    def png(self) -> bytes:
-        """The figure as last drawn (PNG bytes, at the size it is shown with)."""
-        return self._png
-
-    @property
     def text(self) -> str:
         """The readout for the settings shown (or why they could not be shown)."""
         if self.error:
             return f"No figure for these settings: {self.error}"
-        return self._readout(self.result) if self._readout else ""
+        try:
+            return self._readout(self.result) if self._readout else ""
+        except Exception as error:   # noqa: BLE001 - the user's function; the figure stays right
+            return f"The readout failed: {type(error).__name__}: {error}"
 
     @property
     def alt(self) -> str:
@@ -241,7 +241,7 @@ class Explorer:
         return f"{self.title}. Settings: {settings}." + (f" {self.text}".replace("\n", "; ") if self.text else "")
 
     def _apply(self, params: dict) -> None:
-        result = self._compute(**params)
+        result = self._results(tuple(params.items()))   # a setting dragged over again: not recomputed
         self._update(self.handles, result)
         self.result = result
 
@@ -253,13 +253,13 @@ class Explorer:
         except Exception as error:   # noqa: BLE001 - shown to the student; the lecture goes on
             self.error = f"{type(error).__name__}: {error}"
         else:
-            self._png = self.frames.frame()
+            self.png = self.frames.frame()
         self._send()
 
     def static_png(self) -> bytes:
         """The figure for the current settings at its natural size (what a static page shows)."""
         if self.fig.dpi == self.natural_dpi:
-            return self._png
+            return self.png
         shown = self.fig.dpi
         self.fig.set_dpi(self.natural_dpi)
         png = self.frames.frame()
@@ -278,13 +278,10 @@ class Explorer:
         ratio = float(self.screen.get("ratio") or 1.0)
         height, width = self.frames.canvas.get_width_height(physical=True)[::-1]
         with self._view.hold_sync():
-            self._view.png = self._png
+            self._view.png = self.png
             self._view.css_width, self._view.css_height = width / ratio, height / ratio
             self._view.alt = self.alt
         self._text.value = self._readout_html()
-
-    def _on_latest_screen(self) -> None:
-        self._on_screen(self._view.screen)
 
     def _on_screen(self, screen: dict) -> None:
         """Render at the size the figure is shown with: scaled to fit, at the screen's pixel ratio."""
@@ -295,7 +292,7 @@ class Explorer:
         dpi = self.natural_dpi * _fit_scale(natural, self.screen, largest) * ratio
         if abs(dpi - self.fig.dpi) > 1e-6:
             self.fig.set_dpi(dpi)
-            self._png = self.frames.frame()
+            self.png = self.frames.frame()
         self._send()
 
     @property
@@ -306,11 +303,12 @@ class Explorer:
 
             from ._view import FigureView
             width, height = self.frames.canvas.get_width_height(physical=True)
-            self._view = FigureView(png=self._png, alt=self.alt, css_width=float(width),
+            self._view = FigureView(png=self.png, alt=self.alt, css_width=float(width),
                                     css_height=float(height))
             self._text = widgets.HTML(self._readout_html())
             self._text.add_class("ck-readout-box")
-            self._view.observe(lambda change: self._home.run(self._on_latest_screen, key="screen"), names="screen")
+            self._view.observe(lambda change: self._home.run(lambda: self._on_screen(self._view.screen),
+                                                             key="screen"), names="screen")
             header = widgets.HTML(f"<b>{html.escape(self.title)}</b>")
             header.add_class("ck-title")
             column = "270px" if self.lecture else "300px"

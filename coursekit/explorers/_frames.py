@@ -1,20 +1,16 @@
 """Frames of an explorer figure: a full draw when the axes change, blitting otherwise.
 
-While a slider is dragged, most of a matplotlib draw goes into what does not
-move: axes, ticks, labels, grid and the layout. `FrameRenderer` uses
-matplotlib's own blitting: the artists an update moves are marked *animated*,
-so a full draw leaves them out; that draw is kept as the background, and each
-following frame restores it and draws only the moving artists on top.
-
-A full draw happens again only when the background changes: view limits,
-scales, axis labels or titles, the figure's size or resolution, or an artist
-that starts to move. The figure is laid out again (constrained layout, which
-measures all text around the axes) only when that text may measure otherwise:
-not when only the limits move and the tick labels stay as long. The moving artists are found by matplotlib's own
-bookkeeping: setting data or text marks an artist *stale*. So that a blitted
-frame shows what a full draw would, every artist that an axes draws after its
-first moving one (matplotlib draws an axes' children by zorder: a legend, the
-frame) is redrawn with the moving ones.
+Most of a matplotlib draw goes into what a slider does not move: axes, ticks, labels,
+grid and layout. `FrameRenderer` uses matplotlib's blitting: the artists an update
+moves (found by matplotlib's bookkeeping: setting data marks an artist *stale*) are
+marked *animated*, so a full draw leaves them out; that draw is kept as the
+background, and each frame restores it and draws the moving artists on top, with
+every artist their axes draws after them (by zorder) that can meet them (a legend on
+the data, the frame; not a title), so a blitted frame shows what a full draw would.
+A full draw happens again only when the background changes: view limits, scales,
+labels or titles, size or resolution, or an artist that starts to move; the layout
+(constrained layout, which measures all text around the axes) is redone only when
+that text may measure otherwise, not when only the limits move.
 """
 
 from __future__ import annotations
@@ -98,16 +94,19 @@ class FrameRenderer:
         return self._text(), tuple((ax.get_xlim(), ax.get_ylim(), ax.get_position().bounds) for ax in self.fig.axes)
 
     def _animated_now(self) -> list:
-        """Per axes, then for the figure: the children drawn from the first moving one on, in
-        drawing order; [] (a plain full draw each frame) when an axes or an axis is among them."""
+        """Per axes, then for the figure, in drawing order: the moving children, and those drawn
+        after the first moving one that can meet it: inside the axes, where a curve (clipped to it)
+        paints, such as a legend on the data or the frame, not a title or a legend beside it.
+        [] (a plain full draw each frame) when an axes or an axis is among them."""
         from matplotlib.axes import Axes
         from matplotlib.axis import Axis
-        out = []
+        renderer, out = self.canvas.get_renderer(), []
         for parent in self._parents():
             order = sorted((a for a in parent.get_children() if a is not parent.patch), key=attrgetter("zorder"))
             first = next((i for i, a in enumerate(order) if a in self.moving), None)
             if first is not None:
-                out += order[first:]
+                out += [a for a in order[first:] if a in self.moving or parent is self.fig
+                        or a.get_window_extent(renderer).overlaps(parent.bbox.padded(3))]
         return [] if any(isinstance(a, (Axes, Axis)) for a in out) else out
 
     def _full_draw(self) -> None:
