@@ -121,8 +121,10 @@ def slider_grid(explorer) -> list[dict]:
 
 
 def redraw(explorer) -> None:
-    """Compute and draw the explorer's figure for its current settings again: a frame whose
-    axes stay as they are (a blit)."""
+    """Compute and draw the explorer's figure for its current settings again, as for a setting
+    not seen before (the results the explorer keeps are dropped first): a frame whose axes stay
+    as they are (a blit)."""
+    explorer._results.cache_clear()
     explorer.refresh()
 
 
