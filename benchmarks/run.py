@@ -392,7 +392,8 @@ def main() -> None:
         print("\n".join(lines))
         report += lines
     if args.docs:
-        write_docs(ROOT / "docs" / "performance.md", "python benchmarks/run.py " + " ".join(sys.argv[1:]), report)
+        shown = [a for a in sys.argv[1:] if a not in (args.screenshots and str(args.screenshots), "--screenshots")]
+        write_docs(ROOT / "docs" / "performance.md", "python benchmarks/run.py " + " ".join(shown), report)
 
 
 if __name__ == "__main__":
