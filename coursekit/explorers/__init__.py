@@ -1,7 +1,9 @@
-"""Interactive explorers used in the notebooks, one module per chapter.
+"""Interactive explorers used in the notebooks, one module per chapter (``ch1``, ``ch2``, ...).
 
-Each explorer is a pure ``compute`` function (tested without a browser) plus
-a thin `Explorer` wrapper built by a ``*_explorer()`` function.
+Each explorer is a pure ``compute`` function (tested without a browser) plus a thin
+`Explorer` built by a ``*_explorer()`` function. The names below are the kit for writing
+one (docs/extending.md): `Explorer`, its controls `slider`, `int_slider` and `dropdown`, and
+`rescale`, which fits an axes' limits to its data.
 """
 
 from ._base import Explorer, dropdown, int_slider, rescale, slider
