@@ -371,7 +371,8 @@ def test_poles_far_below_the_scale_of_a_warn():
     # issue 25: for A scaled by 1e200 the closed loop's poles came out near 4e193, not at -1 and
     # -2, and the check passed them, measuring the error against A's own size
     A = np.array([[0.0, 1.0], [-2.0, -3.0]]) * 1e200
-    with pytest.warns(ck.AccuracyWarning, match=r"largest error is 3\.9\d*e\+193 at the requested pole"):
+    # the error itself depends on the LAPACK build (3.9e193 and 4.3e193 seen): its size is what counts
+    with pytest.warns(ck.AccuracyWarning, match=r"largest error is \d(\.\d+)?e\+19[0-9] at the requested pole"):
         ck.place(A, [[0.0], [1.0]], [-1.0, -2.0])
     with pytest.warns(ck.AccuracyWarning, match=r"estimation error|requested pole"):
         ck.place_observer(A, [[1.0, 0.0]], [-1.0, -2.0])
