@@ -236,9 +236,12 @@ class Explorer:
     @property
     def alt(self) -> str:
         """The figure's text alternative: the title, the settings and the readout."""
+        return self._alt(self.text)
+
+    def _alt(self, text: str) -> str:
         settings = ", ".join(f"{k} = {v:g}" if isinstance(v, (int, float)) else f"{k} = {v}"
                              for k, v in self.params.items())
-        return f"{self.title}. Settings: {settings}." + (f" {self.text}".replace("\n", "; ") if self.text else "")
+        return f"{self.title}. Settings: {settings}." + (f" {text}".replace("\n", "; ") if text else "")
 
     def _apply(self, params: dict) -> None:
         result = self._results(tuple(params.items()))   # a setting dragged over again: not recomputed
@@ -267,21 +270,21 @@ class Explorer:
         self.frames.frame()
         return png
 
-    def _readout_html(self) -> str:
-        lines = html.escape(self.text).split("\n")
+    def _readout_html(self, text: str) -> str:
+        lines = html.escape(text).split("\n")
         css = "ck-readout ck-error" if self.error else "ck-readout"
         return f'<div class="{css}">' + "<br>".join(lines) + "</div>"
 
     def _send(self) -> None:
         if self._view is None:
             return
-        ratio = float(self.screen.get("ratio") or 1.0)
+        ratio, text = float(self.screen.get("ratio") or 1.0), self.text   # the readout, run once a frame
         height, width = self.frames.canvas.get_width_height(physical=True)[::-1]
         with self._view.hold_sync():
             self._view.png = self.png
             self._view.css_width, self._view.css_height = width / ratio, height / ratio
-            self._view.alt = self.alt
-        self._text.value = self._readout_html()
+            self._view.alt = self._alt(text)
+        self._text.value = self._readout_html(text)
 
     def _on_screen(self, screen: dict) -> None:
         """Render at the size the figure is shown with: scaled to fit, at the screen's pixel ratio."""
@@ -305,7 +308,7 @@ class Explorer:
             width, height = self.frames.canvas.get_width_height(physical=True)
             self._view = FigureView(png=self.png, alt=self.alt, css_width=float(width),
                                     css_height=float(height))
-            self._text = widgets.HTML(self._readout_html())
+            self._text = widgets.HTML(self._readout_html(self.text))
             self._text.add_class("ck-readout-box")
             self._view.observe(lambda change: self._home.run(lambda: self._on_screen(self._view.screen),
                                                              key="screen"), names="screen")
