@@ -142,7 +142,7 @@ def test_the_axes_fitted_to_the_data_hold_them_and_are_half_filled_at_least(fact
             e.refresh()
             for (ax, name), min_span in fitted.items():
                 scale = getattr(ax, f"{name}axis").get_transform()
-                ax.relim()
+                # the data limits the update measured (relim, or update_datalim for an arrow)
                 lo, hi = scale.transform(getattr(ax.dataLim, f"interval{name}"))
                 view = sorted(scale.transform(getattr(ax, f"get_{name}lim")()))
                 assert view[0] <= lo + 1e-9 and hi <= view[1] + 1e-9, (name, value, view, (lo, hi))
@@ -205,6 +205,48 @@ def test_rescale_grows_when_the_data_leave_and_keeps_the_limits_while_they_fill_
     rescale(ax)
     assert ax.get_ylim() == pytest.approx((-0.125, 1.125))
     assert ax.get_xlim() != pytest.approx((-0.125, 1.125))   # x left to matplotlib
+
+
+def test_rescale_only_grows_the_limits_while_a_control_moves():
+    ax = Figure().subplots()
+    line, = ax.plot([0, 1], [0, 1])
+    rescale(ax)
+    moving = _base._moving.set(True)
+    try:
+        line.set_data([0, 1], [0, 0.2])                      # 16 % of the view: kept while moving
+        rescale(ax)
+        assert ax.get_ylim() == pytest.approx((-0.125, 1.125))
+        line.set_data([0, 1], [1.5, 2.0])                    # out at the top: grown, bottom kept
+        rescale(ax)
+        low, high = ax.get_ylim()
+        assert low == pytest.approx(-0.125) and high == pytest.approx(2.0 + 0.5 * (1 / 0.6 - 1) / 2)
+    finally:
+        _base._moving.reset(moving)
+    rescale(ax)                                              # at rest: fitted to the data
+    assert ax.get_ylim() == pytest.approx((1.5 - 0.0625, 2.0 + 0.0625))
+
+
+def test_an_explorer_in_a_kernel_grows_its_limits_during_a_drag_and_fits_them_once_at_rest():
+    import asyncio
+
+    async def drag_then_rest():
+        e = ch1.euler_explorer()            # built where an event loop runs, as in a kernel
+        e.widget                             # shown
+        ts, ax = e.controls["Ts"], e.handles["ax_err"]
+        ts.value = 0.02                      # the error axis (log) fitted to a small error
+        await asyncio.sleep(_base.SETTLE_S + 0.2)
+        small = ax.get_ylim()
+        for value in (0.3, 0.6, 0.3, 0.02):  # out and back: the error grows, then shrinks again
+            ts.value = value
+        during = ax.get_ylim()
+        await asyncio.sleep(_base.SETTLE_S + 0.2)
+        return small, during, ax.get_ylim(), np.log10(ax.dataLim.intervaly), e
+
+    small, during, rested, data, e = asyncio.run(drag_then_rest())
+    assert during[1] > 10 * small[1]         # grown on the way out, not shrunk on the way back
+    # fitted again once the slider rested: the data fill 80 % of the view (in decades)
+    assert np.ptp(data) / np.ptp(np.log10(rested)) == pytest.approx(0.8)
+    assert e.png == e.frames.frame()         # and the rested frame is the one sent
 
 
 def test_rescale_stops_at_sticky_edges_keeps_a_minimum_span_and_works_on_log_axes():

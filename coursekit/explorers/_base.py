@@ -11,7 +11,8 @@ as text next to the controls and not in the figure.
 `Explorer` wires them to controls that report every move while a slider is
 dragged (the widget front end keeps one change in flight, then sends the latest
 value, so the figure ends on the value the hand stopped at). A `FrameRenderer`
-draws each frame, blitting while the axes stay; a `FigureView` shows it at the
+draws each frame, blitting while the axes stay (while a hand moves a control, `rescale`
+only grows the limits; one frame fits them once the controls rest); a `FigureView` shows it at the
 pixel size it was rendered with, for the room and pixel ratio the browser
 reports (in `coursekit.lecture_mode` it also grows to fill the room). Callbacks
 run on the kernel's main thread (`HomeThread`). The display data also carry a
@@ -21,6 +22,7 @@ static PNG, for pages without a kernel (GitHub, nbviewer, the website).
 from __future__ import annotations
 
 import base64
+import contextvars
 import functools
 import html
 from typing import Any, Callable
@@ -37,6 +39,13 @@ __all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale"]
 MIN_SCALE = 0.45
 #: in lecture mode an explorer grows up to this factor to fill the room it has
 LECTURE_MAX_SCALE = 2.0
+#: seconds a control rests before the explorer fits its limits to the data again
+SETTLE_S = 0.3
+#: while a control moves, `rescale` only grows limits, to leave the data this fraction of them
+MOVING_FILL = 0.6
+
+#: True while the frame being drawn follows a control that moves (set by `Explorer`)
+_moving = contextvars.ContextVar("moving", default=False)
 
 
 def _range(value, min, max, step, description):
@@ -90,17 +99,22 @@ def dropdown(options, value, description: str):
     return widgets.Dropdown(options=options, value=value, description=description, **_style())
 
 
-def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, keep: float = 0.5) -> None:
+def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, keep: float = 0.5,
+            relim: bool = True) -> None:
     """Fit the view of each of `axes` to the data its artists hold (call it in an update).
 
     The limits change only when they must: when the data leave them, or fill less than
     `keep` of them. They are then set so that the data fill `fill` of the view, so a
     slider moved on in the same direction changes the axes every few steps, not at each
-    (each change of the axes is a full draw of the figure), and never past an artist's
+    (each change of the axes is a full draw of the figure). While a hand moves a control
+    of an `Explorer` the limits only grow, leaving the data `MOVING_FILL` of them; once the
+    control has rested `SETTLE_S` seconds they are fitted as above. They never go past an artist's
     sticky edges (matplotlib's ``Artist.sticky_edges``: a time axis that starts at 0 gets
     ``line.sticky_edges.x.append(0)``). `axis` is ``"y"``, ``"x"`` or ``"both"``. With
     `min_span`, the view spans at least that much, centred on the data: a response that stays
-    at a constant is drawn flat, not its rounding noise magnified.
+    at a constant is drawn flat, not its rounding noise magnified. With ``relim=False`` the
+    data limits are the ones the update set (``ax.update_datalim``), not measured from the
+    artists again (for artists whose extent matplotlib measures poorly, such as arrows).
     """
     if axis not in ("x", "y", "both"):
         raise ValueError(f"axis must be 'x', 'y' or 'both': received {axis!r}.")
@@ -108,7 +122,8 @@ def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, ke
         raise ValueError(f"fill and keep must satisfy 0 < keep < fill <= 1: received fill={fill!r}, keep={keep!r}.")
     min_span = as_scalar(min_span, "min_span")
     for ax in axes:
-        ax.relim()
+        if relim:
+            ax.relim()
         for name in ("xy" if axis == "both" else axis):
             _fit(ax, name, min_span, fill, keep)
 
@@ -127,9 +142,14 @@ def _fit(ax, name: str, min_span: float, fill: float, keep: float) -> None:
         half = 0.05 * (abs(lo) or 1.0)
         lo, hi = lo - half, hi + half
     auto = getattr(ax, f"get_autoscale{name}_on")()
+    moving = _moving.get() and not auto      # a hand moves a control: the limits only grow
+    if moving:
+        keep, fill = 0.0, min(fill, MOVING_FILL)
     if auto or lo < view[0] or hi > view[1] or hi - lo < keep * (view[1] - view[0]):
         pad = (hi - lo) * (1 / fill - 1) / 2
         low, high = lo - pad, hi + pad
+        if moving:
+            low, high = min(low, view[0]), max(high, view[1])
         with np.errstate(all="ignore"):   # sticky edges: no room past them (a time axis' start)
             sticky = scale.transform([s for a in ax.get_children() for s in getattr(a.sticky_edges, name)])
         low = max([low, *(s for s in sticky if low < s <= lo)])
@@ -199,8 +219,9 @@ class Explorer:
         # every callback on the kernel's main thread, whichever thread a message arrives on
         from ._home import HomeThread
         self._home = HomeThread()
+        self._settle = None
         for w in self.controls.values():
-            w.observe(lambda change: self._home.run(self.refresh, key="refresh"), names="value")
+            w.observe(lambda change: self._home.run(self._moved, key="refresh"), names="value")
 
     @staticmethod
     def _check(title, controls, functions: dict) -> None:
@@ -258,6 +279,27 @@ class Explorer:
         else:
             self.png = self.frames.frame()
         self._send()
+
+    def _moved(self) -> None:
+        """A control moved. In a kernel (an event loop runs) the frame is drawn with limits that
+        only grow (`rescale`), and a frame with fitted limits follows once the controls have
+        rested `SETTLE_S` seconds; elsewhere the frame is fitted at once."""
+        loop = self._home.loop
+        if loop is None or not loop.is_running():
+            self.refresh()
+            return
+        if self._settle is not None:
+            self._settle.cancel()
+        moving = _moving.set(True)
+        try:
+            self.refresh()
+        finally:
+            _moving.reset(moving)
+        self._settle = loop.call_later(SETTLE_S, self._rested)
+
+    def _rested(self) -> None:
+        self._settle = None
+        self.refresh()      # sends nothing when the fitted frame is the one shown
 
     def static_png(self) -> bytes:
         """The figure for the current settings at its natural size (what a static page shows)."""
