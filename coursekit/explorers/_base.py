@@ -1,22 +1,14 @@
 """The machinery shared by every explorer: controls that redraw one figure as they move.
 
-An explorer is three plain functions, an optional fourth, and a set of controls:
-``compute(**params)``, pure numerics, unit-tested without a browser (where the
-course's algorithms are called); ``draw(fig)``, which builds the axes and empty
-artists once and returns handles; ``update(handles, result)``, which moves the
-artists' data and sets the view limits (`rescale` fits them to the data); and
-``readout(result)``, the numbers worth reading (gains, poles, a verdict), shown
-as text next to the controls and not in the figure.
-
-`Explorer` wires them to controls that report every move while a slider is
-dragged (the widget front end keeps one change in flight, then sends the latest
-value, so the figure ends on the value the hand stopped at). A `FrameRenderer`
-draws each frame, blitting while the axes stay (while a hand moves a control, `rescale`
-only grows the limits; one frame fits them once the controls rest); a `FigureView` shows it at the
-pixel size it was rendered with, for the room and pixel ratio the browser
-reports (in `coursekit.lecture_mode` it also grows to fill the room). Callbacks
-run on the kernel's main thread (`HomeThread`). The display data also carry a
-static PNG, for pages without a kernel (GitHub, nbviewer, the website).
+An explorer is a set of controls and plain functions: ``compute(**params)``, pure numerics
+(unit-tested without a browser); ``draw(fig)``, which builds axes and empty artists once and
+returns handles; ``update(handles, result)``, which moves the artists' data and sets the
+limits (`rescale`); and optionally ``readout(result)``, the numbers worth reading, shown next
+to the controls. A `FrameRenderer` draws each frame, blitting while the axes stay (while a
+hand moves a control `rescale` only grows the limits; one frame fits them once it rests); a
+`FigureView` shows it at the size and pixel ratio the browser reports. Callbacks run on the
+kernel's main thread (`HomeThread`). The display data also carry a static PNG, for pages
+without a kernel (GitHub, the website).
 """
 
 from __future__ import annotations
@@ -39,10 +31,9 @@ __all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale"]
 MIN_SCALE = 0.45
 #: in lecture mode an explorer grows up to this factor to fill the room it has
 LECTURE_MAX_SCALE = 2.0
-#: seconds a control rests before the explorer fits its limits to the data again
-SETTLE_S = 0.3
-#: while a control moves, `rescale` only grows limits, to leave the data this fraction of them
-MOVING_FILL = 0.6
+#: seconds the controls rest before the limits are fitted again; till then they only grow, to
+#: leave the data MOVING_FILL of them
+SETTLE_S, MOVING_FILL = 0.3, 0.6
 
 #: True while the frame being drawn follows a control that moves (set by `Explorer`)
 _moving = contextvars.ContextVar("moving", default=False)
@@ -216,7 +207,6 @@ class Explorer:
         self.frames = FrameRenderer(self.fig)
         self.png = self.frames.frame()     # the figure as last drawn, at the size it is shown with
         self._widget = self._view = self._text = None
-        # every callback on the kernel's main thread, whichever thread a message arrives on
         from ._home import HomeThread
         self._home = HomeThread()
         self._settle = None
@@ -283,23 +273,19 @@ class Explorer:
     def _moved(self) -> None:
         """A control moved. In a kernel (an event loop runs) the frame is drawn with limits that
         only grow (`rescale`), and a frame with fitted limits follows once the controls have
-        rested `SETTLE_S` seconds; elsewhere the frame is fitted at once."""
+        rested `SETTLE_S` seconds (it sends nothing when it is the frame shown); elsewhere the
+        frame is fitted at once."""
         loop = self._home.loop
         if loop is None or not loop.is_running():
-            self.refresh()
-            return
+            return self.refresh()
         if self._settle is not None:
             self._settle.cancel()
+        self._settle = loop.call_later(SETTLE_S, self.refresh)
         moving = _moving.set(True)
         try:
             self.refresh()
         finally:
             _moving.reset(moving)
-        self._settle = loop.call_later(SETTLE_S, self._rested)
-
-    def _rested(self) -> None:
-        self._settle = None
-        self.refresh()      # sends nothing when the fitted frame is the one shown
 
     def static_png(self) -> bytes:
         """The figure for the current settings at its natural size (what a static page shows)."""

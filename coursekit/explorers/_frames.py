@@ -1,16 +1,11 @@
 """Frames of an explorer figure: a full draw when the axes change, blitting otherwise.
 
-Most of a matplotlib draw goes into what a slider does not move: axes, ticks, labels,
-grid and layout. `FrameRenderer` uses matplotlib's blitting: the artists an update
-moves (found by matplotlib's bookkeeping: setting data marks an artist *stale*) are
-marked *animated*, so a full draw leaves them out; that draw is kept as the
-background, and each frame restores it and draws the moving artists on top, with
-every artist their axes draws after them (by zorder) that can meet them (a legend on
-the data, the frame; not a title), so a blitted frame shows what a full draw would.
-A full draw happens again only when the background changes: view limits, scales,
-labels or titles, size or resolution, or an artist that starts to move; the layout
-(constrained layout, which measures all text around the axes) is redone only when
-that text may measure otherwise, not when only the limits move.
+Most of a draw goes into what a slider does not move: axes, ticks, labels, layout. The artists
+an update moves (matplotlib marks them *stale*) are made *animated*, so a full draw leaves them
+out; that draw is kept as the background, and each frame restores it and draws on top the moving
+artists and every artist drawn after them (by zorder) that can meet them (a legend on the data,
+not a title), so a blitted frame shows what a full draw would. A full draw happens again only
+when the background changes: limits, scales, labels, titles, size, or a new moving artist.
 """
 
 from __future__ import annotations
@@ -49,7 +44,7 @@ class FrameRenderer:
         self.moving: set = set()
         self._animated: list = []
         self._background = None
-        self._key = self._layout = None
+        self._key = None
         self.full_draws = self.blits = 0
 
     def reset(self) -> None:
@@ -115,36 +110,13 @@ class FrameRenderer:
         self._animated = self._animated_now()
         for artist in self._animated:
             artist.set_animated(True)
-        self._draw_background()
+        self.canvas.draw()
         self._background = self.canvas.copy_from_bbox(self.fig.bbox) if self._animated else None
         self._draw_animated()
         for artist in self._children():      # drawn, or never drawn (an empty title)
             artist.stale = False
         self._key = self._state()
         self.full_draws += 1
-
-    def _draw_background(self) -> None:
-        """Draw the figure (without the animated artists), laying it out only when the text
-        around the axes may measure differently: the layout engine measures every tick label and
-        title, as much work again as the draw itself, and while a drag moves only the limits its
-        result stays the same."""
-        layout = self._layout_state()
-        engine = self.fig.get_layout_engine()
-        if engine is None or layout != self._layout:
-            self.canvas.draw()
-            self._layout = layout
-            return
-        self.fig.set_layout_engine("none")   # the axes stay where the last layout put them
-        try:
-            self.canvas.draw()
-        finally:
-            self.fig.set_layout_engine(engine)
-
-    def _layout_state(self):
-        """What the layout depends on: the text around the axes and its widest tick labels."""
-        def widest(axis):
-            return max(map(len, axis.get_major_formatter().format_ticks(axis.get_major_locator()())), default=0)
-        return self._text(), tuple((widest(ax.xaxis), widest(ax.yaxis)) for ax in self.fig.axes)
 
     def _draw_animated(self) -> None:
         renderer = self.canvas.get_renderer()

@@ -1,15 +1,10 @@
 """Widget callbacks run on the kernel's main thread, one at a time.
 
-A front end may hand widget messages to a kernel *subshell*, a second thread of
-the kernel (JupyterLab 4.6 does so by default with ipykernel 7: its setting
-``commsOverSubshells``). A slider moved or a screen report then reaches the
-explorer on that thread while a cell, or another explorer, draws on the main
-thread; matplotlib is not safe for that (figures and the font cache they share
-get corrupted: garbled frames, "failed to load glyph" errors). `HomeThread`
-remembers the thread that built the widget and its event loop, and runs each
-callback there: at once when it arrives on that thread, else queued on the
-loop, which runs it between cells. Without a running loop (plain Python, the
-tests) callbacks run where they arrive.
+A front end may hand widget messages to a second thread of the kernel (a *subshell*: JupyterLab
+4.6 with ipykernel 7 does so by default), while a cell or another explorer draws on the main
+thread; matplotlib is not safe for that (garbled frames, "failed to load glyph"). `HomeThread`
+remembers the thread and event loop that built the widget and runs each callback there: at once
+when it arrives there, else queued on the loop, between cells. Without a loop, where it arrives.
 """
 
 from __future__ import annotations

@@ -1,13 +1,10 @@
 """The browser side of an explorer: its figure at the screen's own pixel size, and its styling.
 
-`FigureView` is a small anywidget (JavaScript shipped as a string, no build step; it works in
-JupyterLab, Notebook 7, VS Code and Colab). It shows the kernel's PNG as an ``<img>`` whose CSS
-size is the PNG's pixel size over the device pixel ratio, so the browser never scales it, and
-reports the pixel ratio and the room the figure has (the output's width, the visible height
-less the title, controls and readout) when shown and when that room changes; it asks the
-kernel for nothing else, so while nobody touches a control the kernel does no work. A screen
-reader finds the figure's text alternative on the image; a polite live region announces it
-once a control has rested (not at every frame of a drag).
+`FigureView` is a small anywidget (JavaScript as a string, no build step). It shows the kernel's
+PNG as an ``<img>`` at the PNG's pixel size over the device pixel ratio (never scaled), and
+reports the pixel ratio and the room the figure has when shown and when that room changes; it
+asks for nothing else, so while nobody touches a control the kernel does no work. The image
+carries the text alternative; a polite live region announces it once a control has rested.
 """
 
 from __future__ import annotations
