@@ -5,20 +5,24 @@ notebook for a projector. Run in a notebook cell, it displays an output that hol
 ``<style>`` element: CSS that sets JupyterLab's own size variables (``--jp-content-font-size1``
 for markdown and HTML outputs, ``--jp-code-font-size`` for code and text outputs,
 ``--jp-ui-font-size1``, the prompt width and the ipywidgets sizes) on the notebook that shows
-the output. JupyterLab 4 and Notebook 7 (the same notebook widget) read these variables, so
-every cell follows, those above the call too.
+the output, and hides the output's own (empty) row. JupyterLab 4 and Notebook 7 (the same
+notebook widget) read these variables, so every cell follows, those above the call too.
 
 The rule applies only inside a live notebook (an element of class
-``jp-NotebookPanel-notebook`` that holds the ``<style>``): other open notebooks, the rest of
-JupyterLab, nbconvert's HTML and slides, and the course website (which have no such element)
-keep their sizes even when the output is stored. Switching off (``show_lecture_text(False)``)
-replaces the output, through IPython's ``update_display`` and the output's display id, with
-nothing; clearing the cell's outputs does the same. The output carries no ``text/plain``
-form, so front ends that show no HTML show nothing at all.
+``jp-NotebookPanel-notebook`` that holds the "on" ``<style>``): other open notebooks, the rest
+of JupyterLab, nbconvert's HTML and slides and the course website (none has such an element
+around the output) keep their sizes even when the output is stored; JupyterLab
+removes the ``<style>`` from outputs it does not trust (a notebook from someone else), and
+GitHub strips it. Switching off (``show_lecture_text(False)``) replaces every output shown with
+`DISPLAY_ID` in this kernel session, through IPython's ``update_display``, by an "off" style
+that only hides its row; running or clearing the cell does the same. JupyterLab forgets display
+ids when the kernel restarts, so outputs made before a restart stay until their cell runs again
+or is cleared. The output carries no ``text/plain`` form, so front ends that show no HTML show
+nothing at all.
 
 Outside a notebook kernel (plain Python, a terminal IPython, the tests) nothing is displayed.
 JupyterLab's windowing mode "full" detaches cells scrolled out of view from the page, and with
-them the style; the default mode keeps every cell attached.
+them the style; the default mode ("contentVisibility") keeps every cell attached.
 """
 
 from __future__ import annotations
@@ -75,7 +79,8 @@ def show_lecture_text(on: bool) -> bool:
 
     Returns True when a notebook kernel received it, False outside a notebook (nothing done).
     Switching on displays a new output each time (re-running the cell that switched it on
-    replaces that cell's output); switching off empties every output shown with `DISPLAY_ID`.
+    replaces that cell's output); switching off turns every output this kernel session showed
+    with `DISPLAY_ID` into the "off" style (`lecture_text_html(False)`).
     """
     if _notebook_shell() is None:
         return False
