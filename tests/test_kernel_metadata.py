@@ -88,6 +88,15 @@ def test_tools_that_rewrite_a_notebook_keep_its_kernel_metadata(rewrite):
 def test_with_kernel_metadata_refuses_an_incomplete_dictionary():
     with pytest.raises(ValueError, match=r"metadata lacks \['language_info'\]"):
         with_kernel_metadata(_small(), {"kernelspec": kernelspec_metadata()})
+    with pytest.raises(TypeError, match="metadata must be a dict: received str"):
+        with_kernel_metadata(_small(), "python3")
+
+
+@pytest.mark.parametrize("kwargs, match", [({"notebooks": 3}, "notebooks must be a folder path"),
+                                           ({"write": "no"}, "write must be True or False")])
+def test_apply_kernel_metadata_checks_its_arguments(kwargs, match):
+    with pytest.raises(TypeError, match=match):
+        apply_kernel_metadata(metadata={}, **kwargs)
 
 
 def test_kernelspec_of_a_kernel_that_is_not_installed():

@@ -71,6 +71,9 @@ def kernel_metadata(kernel_name: str = COURSE_KERNEL) -> dict:
 def with_kernel_metadata(nb, metadata: dict):
     """`nb` with the entries of `metadata` (from `kernel_metadata`) in its metadata; changed
     in place and returned."""
+    if not isinstance(metadata, dict):
+        raise TypeError(f"metadata must be a dict: received {type(metadata).__name__}; pass what "
+                        "kernel_metadata() returns.")
     missing = [key for key in KERNEL_KEYS if key not in metadata]
     if missing:
         raise ValueError(f"metadata lacks {missing}: pass the dictionary kernel_metadata() returns.")
@@ -84,6 +87,9 @@ def apply_kernel_metadata(notebooks: Path | str | None = None, *, write: bool = 
     """Store `metadata` (default: `kernel_metadata()` of this environment) in every notebook of
     the folder `notebooks` (default: the repository's ``notebooks/``); return the notebooks
     whose stored entries differ. With ``write=False`` nothing is written."""
+    if notebooks is not None and not isinstance(notebooks, (str, Path)):
+        raise TypeError(f"notebooks must be a folder path (str or Path) or None: received "
+                        f"{type(notebooks).__name__}.")
     if not isinstance(write, bool):
         raise TypeError(f"write must be True or False: received {write!r}.")
     _, paths = notebook_paths(notebooks)
