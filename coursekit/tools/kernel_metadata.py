@@ -87,9 +87,6 @@ def apply_kernel_metadata(notebooks: Path | str | None = None, *, write: bool = 
     """Store `metadata` (default: `kernel_metadata()` of this environment) in every notebook of
     the folder `notebooks` (default: the repository's ``notebooks/``); return the notebooks
     whose stored entries differ. With ``write=False`` nothing is written."""
-    if notebooks is not None and not isinstance(notebooks, (str, Path)):
-        raise TypeError(f"notebooks must be a folder path (str or Path) or None: received "
-                        f"{type(notebooks).__name__}.")
     if not isinstance(write, bool):
         raise TypeError(f"write must be True or False: received {write!r}.")
     _, paths = notebook_paths(notebooks)
