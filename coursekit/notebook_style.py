@@ -11,9 +11,9 @@ notebook widget) read these variables, so every cell follows, those above the ca
 The rule applies only inside a live notebook (an element of class
 ``jp-NotebookPanel-notebook`` that holds the "on" ``<style>``): other open notebooks, the rest
 of JupyterLab, nbconvert's HTML and slides and the course website (none has such an element
-around the output) keep their sizes even when the output is stored; JupyterLab
-removes the ``<style>`` from outputs it does not trust (a notebook from someone else), and
-GitHub strips it. Switching off (``show_lecture_text(False)``) replaces every output shown with
+around the output; nor have GitHub's and nbviewer's renderings) keep their sizes even when the
+output is stored; JupyterLab removes the ``<style>`` from outputs it does not trust (a
+notebook saved by someone else). Switching off (``show_lecture_text(False)``) replaces every output shown with
 `DISPLAY_ID` in this kernel session, through IPython's ``update_display``, by an "off" style
 that only hides its row; running or clearing the cell does the same. JupyterLab forgets display
 ids when the kernel restarts, so outputs made before a restart stay until their cell runs again
