@@ -54,12 +54,18 @@ def _add_slides(commands) -> None:
         description="Give every cell of the course notebooks its slide type, so that "
                     "'jupyter nbconvert --to slides' makes one slide per section (## heading) and a "
                     "sub-slide per subsection (### heading) and per paragraph with its code. Rewrites "
-                    "the notebooks in place; --check only reports the notebooks that are out of date.")
+                    "the notebooks in place; --check only reports the notebooks that are out of date. "
+                    "With --kernel-metadata, also stores the kernel metadata JupyterLab writes when it "
+                    "opens a notebook with this environment's python3 kernel (its Python version "
+                    "included), so that a notebook opened and closed untouched asks nothing.")
     parser.add_argument("--notebooks", type=Path, default=None, metavar="DIR",
                         help="folder of the notebooks (default: the repository's notebooks/)")
     parser.add_argument("--check", action="store_true",
-                        help="change nothing; exit with status 1 when a notebook's slide metadata is "
-                             "out of date")
+                        help="change nothing; exit with status 1 when a notebook's slide metadata (and, "
+                             "with --kernel-metadata, its kernel metadata) is out of date")
+    parser.add_argument("--kernel-metadata", action="store_true",
+                        help="also store the kernel metadata of this environment's python3 kernel (run "
+                             "it with the course's reference Python; see CONTRIBUTING.md)")
     parser.set_defaults(run=_run_slides)
 
 
@@ -69,10 +75,25 @@ def _run_slides(args) -> int:
     if args.check:
         for path in changed:
             print(f"slide metadata out of date: {path.name} (run: python -m coursekit slides)")
-        return 1 if changed else 0
-    print(f"slide metadata updated in {len(changed)} notebook(s)" if changed else
-          "slide metadata already up to date")
-    return 0
+    else:
+        print(f"slide metadata updated in {len(changed)} notebook(s)" if changed else
+              "slide metadata already up to date")
+    stale = _run_kernel_metadata(args) if args.kernel_metadata else []
+    return 1 if args.check and (changed or stale) else 0
+
+
+def _run_kernel_metadata(args) -> list:
+    from .tools.kernel_metadata import apply_kernel_metadata, kernel_metadata
+    metadata = kernel_metadata()
+    changed = apply_kernel_metadata(args.notebooks, write=not args.check, metadata=metadata)
+    python = metadata["language_info"].get("version", "?")
+    for path in changed if args.check else []:
+        print(f"kernel metadata out of date for Python {python}: {path.name} "
+              "(run: python -m coursekit slides --kernel-metadata)")
+    if not args.check:
+        print(f"kernel metadata of Python {python} stored in {len(changed)} notebook(s)" if changed else
+              f"kernel metadata already that of Python {python}")
+    return changed
 
 
 def _add_colab(commands) -> None:

@@ -3,6 +3,8 @@
 Every figure coursekit makes is created with `new_figure`, which reads the
 current matplotlib settings, so switching `lecture_mode` on before building
 a plot or an explorer makes it readable from the back of a lecture hall.
+In a notebook, `lecture_mode` also enlarges the notebook's own text
+(`coursekit.notebook_style`).
 """
 
 from __future__ import annotations
@@ -10,6 +12,7 @@ from __future__ import annotations
 import numpy as np
 
 from ._validation import as_flag, as_integer, as_vector
+from .notebook_style import show_lecture_text
 
 __all__ = ["lecture_mode", "is_lecture_mode", "new_figure", "fit_margins", "LECTURE_STYLE"]
 
@@ -41,8 +44,13 @@ def lecture_mode(on: bool = True) -> None:
     """Switch large fonts, thick lines and big figures on (or back off).
 
     Affects every figure created afterwards: notebook plots, coursekit's
-    plotting helpers and explorers built after the call. ``lecture_mode(False)``
-    restores the settings that were in force before it was switched on.
+    plotting helpers and explorers built after the call. Called in a notebook
+    cell (JupyterLab 4, Notebook 7), it also enlarges the notebook's own text at
+    once: markdown, code, outputs and widgets, in every cell (it displays an
+    invisible style output, see `coursekit.notebook_style`). ``lecture_mode(False)``
+    restores the matplotlib settings that were in force before it was switched
+    on and the notebook's text sizes. Outside a notebook only the figure
+    settings change.
     """
     on = as_flag(on, "on", hint="call lecture_mode() to switch on, lecture_mode(False) to switch off")
     import matplotlib as mpl
@@ -54,6 +62,7 @@ def lecture_mode(on: bool = True) -> None:
     elif _saved is not None:
         mpl.rcParams.update(_saved)
         _saved = None
+    show_lecture_text(on)
 
 
 def is_lecture_mode() -> bool:

@@ -19,6 +19,7 @@ failure, the benchmark into a message.
 from __future__ import annotations
 
 import contextlib
+import functools
 import json
 import os
 import re
@@ -67,12 +68,20 @@ def missing_reason() -> str | None:
     return None
 
 
-def write_notebook(path: Path, sources: list[str]) -> None:
-    """A notebook with one code cell per source string, for the python3 kernel."""
+@functools.lru_cache(maxsize=1)
+def _kernel_metadata() -> dict:
+    from coursekit.tools.kernel_metadata import kernel_metadata
+    return kernel_metadata()
+
+
+def write_notebook(path: Path, cells: list) -> None:
+    """A notebook of `cells` (a string is a code cell of that source; an nbformat cell is taken
+    as it is) for the python3 kernel, with the kernel metadata JupyterLab writes for this
+    environment's kernel, so that opening it changes nothing."""
     import nbformat
-    nb = nbformat.v4.new_notebook()
-    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
-    nb.cells = [nbformat.v4.new_code_cell(src) for src in sources]
+    from coursekit.tools.kernel_metadata import with_kernel_metadata
+    nb = with_kernel_metadata(nbformat.v4.new_notebook(), _kernel_metadata())
+    nb.cells = [nbformat.v4.new_code_cell(cell) if isinstance(cell, str) else cell for cell in cells]
     nbformat.write(nb, path)
 
 

@@ -9,6 +9,7 @@ import pytest
 
 import coursekit as ck
 from coursekit.explorers import Explorer, dropdown, int_slider, slider
+from coursekit.tools.kernel_metadata import kernelspec_metadata
 
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 
@@ -109,7 +110,7 @@ def executed_demo():
     pytest.importorskip("nbclient")
     from nbclient import NotebookClient
     nb = nbformat.v4.new_notebook()
-    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nb.metadata["kernelspec"] = kernelspec_metadata()
     nb.cells = [nbformat.v4.new_code_cell(
         "import numpy as np\nfrom coursekit.explorers import Explorer, dropdown, int_slider, slider\n"
         "Explorer(title='Demo', controls={'a': slider(1.0, 0.1, 3.0, 0.1, 'a')},\n"

@@ -21,6 +21,7 @@ import pytest
 
 from coursekit.tools import site
 from coursekit.tools.chapters import chapter_notebooks
+from coursekit.tools.kernel_metadata import kernelspec_metadata
 from coursekit.__main__ import main
 
 NOTEBOOKS = Path(__file__).parents[1] / "notebooks"
@@ -230,7 +231,7 @@ def _small_build(tmp_path, student):
     folder = tmp_path / "nb"
     folder.mkdir(exist_ok=True)
     nb = nbformat.v4.new_notebook()
-    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nb.metadata["kernelspec"] = kernelspec_metadata()
     nb.cells = SMALL_NOTEBOOK
     nbformat.write(nb, folder / "07_small.ipynb")
     index = site.build_site(tmp_path / ("student" if student else "site"), student=student,
@@ -324,7 +325,7 @@ def test_the_site_builds_with_every_outside_connection_refused(tmp_path):
     folder = tmp_path / "nb"
     folder.mkdir()
     nb = nbformat.v4.new_notebook()
-    nb.metadata["kernelspec"] = {"name": "python3", "display_name": "Python 3", "language": "python"}
+    nb.metadata["kernelspec"] = kernelspec_metadata()
     nb.cells = SMALL_NOTEBOOK + [_code("import socket\ntry:\n    socket.create_connection(('192.0.2.1', 80), 1)\n"
                                        "except OSError as e:\n    print('refused:', e)")]
     nbformat.write(nb, folder / "07_small.ipynb")

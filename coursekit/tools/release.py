@@ -78,7 +78,11 @@ def default_notebook_dir() -> Path:
 
 def notebook_paths(notebooks=None) -> tuple[Path, list[Path]]:
     """The folder of the course notebooks (`notebooks`, default `default_notebook_dir`) and its
-    ``*.ipynb`` files, sorted; ValueError when it holds none."""
+    ``*.ipynb`` files, sorted; ValueError when it holds none, TypeError when `notebooks` is
+    not a path."""
+    if notebooks is not None and not isinstance(notebooks, (str, Path)):
+        raise TypeError(f"notebooks must be a folder path (str or Path) or None: received "
+                        f"{type(notebooks).__name__}.")
     folder = default_notebook_dir() if notebooks is None else Path(notebooks)
     paths = sorted(folder.glob("*.ipynb"))
     if not paths:
