@@ -3,6 +3,8 @@
 Every function builds a new figure with `coursekit.style.new_figure` (so
 `lecture_mode` applies), labels every axis with its unit, and returns the
 figure; in a notebook, make it the last expression of the cell to show it.
+Curves take the course's colours with a line style (or marker) each
+(`coursekit.style.curve_style`), so none is told from another by colour alone.
 matplotlib is imported inside the functions.
 """
 
@@ -12,7 +14,7 @@ import numpy as np
 
 from ._validation import as_integer, as_matrix, as_text
 from .simulation import SimulationResult
-from .style import figure_for, new_figure
+from .style import curve_style, figure_for, new_figure, text_colour
 
 __all__ = ["plot_response", "plot_state_plane", "plot_euler_comparison"]
 
@@ -127,10 +129,10 @@ def plot_response(result, which: str = "xu", *, state_names=None, output_names=N
 
 def _draw_signals(ax, t, data, names, units, *, discrete: bool) -> None:
     same = len(set(units)) == 1
-    style = dict(marker="o", markersize=4, linewidth=0.8) if discrete else {}
+    size = dict(markersize=4, linewidth=0.8) if discrete else {}
     for j in range(data.shape[1]):
         label = names[j] if same else f"{names[j]} [{units[j]}]"
-        ax.plot(t, data[:, j], label=label, **style)
+        ax.plot(t, data[:, j], label=label, **curve_style(j, marker=discrete), **size)
     ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
 
 
@@ -208,11 +210,10 @@ def plot_state_plane(trajectories, *, states=(0, 1), labels=None, state_names=No
         raise ValueError(f"labels has {len(labels)} entries, expected {len(items)} (one per trajectory).")
     fig, ax = figure_for(ax, figsize=figsize)
     for k, ((pts, _), label) in enumerate(zip(items, labels)):
-        color = f"C{k}"
         if numbered if numbered is not None else len(pts) <= 25:
-            _numbered_points(ax, pts, color=color, label=label)
+            _numbered_points(ax, pts, style=curve_style(k, marker=True), label=label)
         else:
-            _directed_line(ax, pts, color=color, label=label)
+            _directed_line(ax, pts, style=curve_style(k), label=label)
     ax.set_xlabel(f"{names[0]} [{units[0]}]")
     ax.set_ylabel(f"{names[1]} [{units[1]}]")
     ax.axhline(0, color="0.6", linewidth=0.8)
@@ -226,9 +227,14 @@ def plot_state_plane(trajectories, *, states=(0, 1), labels=None, state_names=No
     return fig
 
 
-def _numbered_points(ax, pts: np.ndarray, *, color: str, label: str) -> None:
-    """Points with their time index (coinciding points share a label), curved arrows between them."""
-    ax.plot(pts[:, 0], pts[:, 1], "o", color=color, markersize=8, label=label)
+def _numbered_points(ax, pts: np.ndarray, *, style: dict, label: str) -> None:
+    """Points with their time index (coinciding points share a label), curved arrows between them.
+
+    The points carry the trajectory's marker (`style`), the arrows its colour, the time labels
+    its colour darkened to text contrast."""
+    color = style["color"]
+    ax.plot(pts[:, 0], pts[:, 1], linestyle="None", marker=style["marker"], color=color, markersize=8,
+            label=label)
     for k in range(len(pts) - 1):
         ax.annotate("", xy=pts[k + 1], xytext=pts[k],
                     arrowprops=dict(arrowstyle="-|>", color=color, shrinkA=6, shrinkB=6,
@@ -238,14 +244,15 @@ def _numbered_points(ax, pts: np.ndarray, *, color: str, label: str) -> None:
         groups.setdefault(tuple(np.round(p, 9)), []).append(k)
     for p, times in groups.items():
         ax.annotate("t = " + ", ".join(str(k) for k in times), xy=p, xytext=(8, 8),
-                    textcoords="offset points", color=color)
+                    textcoords="offset points", color=text_colour(color))
 
 
-def _directed_line(ax, pts: np.ndarray, *, color: str, label: str, arrows: int = 6) -> None:
-    """A long trajectory: a line, its start marked, a few arrows along it."""
-    ax.plot(pts[:, 0], pts[:, 1], color=color, label=label)
+def _directed_line(ax, pts: np.ndarray, *, style: dict, label: str, arrows: int = 6) -> None:
+    """A long trajectory: a line in `style`, its start marked, a few arrows along it."""
+    color = style["color"]
+    ax.plot(pts[:, 0], pts[:, 1], label=label, **style)
     ax.plot(pts[0, 0], pts[0, 1], "o", color=color)
-    ax.annotate("t = 0", xy=pts[0], xytext=(8, 8), textcoords="offset points", color=color)
+    ax.annotate("t = 0", xy=pts[0], xytext=(8, 8), textcoords="offset points", color=text_colour(color))
     step = max(1, len(pts) // (arrows + 1))
     for k in range(step, len(pts) - 1, step):
         ax.annotate("", xy=pts[k + 1], xytext=pts[k],
@@ -287,11 +294,11 @@ def plot_euler_comparison(exact, approximations, *, state: int = 0, state_name: 
     for k, res in enumerate(items):
         Ts = res.system.dt
         xk = res.x[:, state]
-        ax.plot(res.t, xk, "o--", markersize=3, linewidth=0.8, color=f"C{k}", label=f"Euler, Ts = {Ts:g}")
+        ax.plot(res.t, xk, markersize=3, linewidth=0.8, label=f"Euler, Ts = {Ts:g}", **curve_style(k, marker=True))
         # from k = 1 on (at k = 0 both equal x0); only inside the exact time range
         keep = (res.t <= exact.t[-1] + 1e-12) & (np.arange(res.t.size) > 0)
         err = np.abs(xk[keep] - np.interp(res.t[keep], exact.t, ref))
-        ax_err.semilogy(res.t[keep], np.maximum(err, 1e-16), color=f"C{k}", label=f"Ts = {Ts:g}")
+        ax_err.semilogy(res.t[keep], np.maximum(err, 1e-16), label=f"Ts = {Ts:g}", **curve_style(k))
     # keep the exact solution readable when an unstable approximation blows up
     ax.set_ylim(ref.min() - 0.5 * span, ref.max() + 0.5 * span)
     ax.set_xlim(exact.t[0], exact.t[-1])

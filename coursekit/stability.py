@@ -94,22 +94,23 @@ def plot_poles(poles, *, dt=None, ax=None, title: str | None = None):
     """
     sets = _as_pole_sets(poles)
     dt = as_dt(dt)
-    from .style import figure_for
+    from .style import PALETTE, curve_style, figure_for
     fig, ax = figure_for(ax)
+    green = PALETTE["bluish green"]
     everything = np.concatenate(list(sets.values()))
     reach = 1.25 * max(1.0, float(np.abs(everything.real).max(initial=0)),
                        float(np.abs(everything.imag).max(initial=0)))
     if dt is None:
-        ax.axvspan(-reach, 0, color="tab:green", alpha=0.12, label="stable region (Re < 0)")
+        ax.axvspan(-reach, 0, color=green, alpha=0.12, label="stable region (Re < 0)")
     else:
         angle = np.linspace(0, 2 * np.pi, 200)
-        ax.fill(np.cos(angle), np.sin(angle), color="tab:green", alpha=0.12, label="stable region (|z| < 1)")
-        ax.plot(np.cos(angle), np.sin(angle), color="tab:green", lw=1)
+        ax.fill(np.cos(angle), np.sin(angle), color=green, alpha=0.12, label="stable region (|z| < 1)")
+        ax.plot(np.cos(angle), np.sin(angle), color=green, lw=1)
         ax.set_aspect("equal", adjustable="datalim")   # the axes fills its cell, as the layout sets it
     markers = "xo^sd*"
     for i, (label, values) in enumerate(sets.items()):
         ax.plot(values.real, values.imag, markers[i % len(markers)], ms=10, mew=2,
-                fillstyle="none", label=label)
+                color=curve_style(i)["color"], fillstyle="none", label=label)
     ax.axhline(0, color="0.5", lw=0.8)
     ax.axvline(0, color="0.5", lw=0.8)
     if dt is None:

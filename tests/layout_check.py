@@ -48,9 +48,25 @@ def _draw_calling(fig, on_text) -> object:
 
 
 def _draw_recording(fig) -> tuple[list[Text], object]:
-    """Draw `fig` with Agg; return the Text artists in the order they were drawn, and the renderer."""
+    """Draw `fig` with Agg; return the Text artists drawn (in the order they were drawn, those of
+    several lines last), and the renderer.
+
+    matplotlib names the artist only for a text of one line: a text of several lines (a "\\n" in
+    it, or wrapped) is drawn line by line without it, and is found here by its first line."""
     drawn: dict[int, Text] = {}
-    renderer = _draw_calling(fig, lambda s, ismath, mtext: mtext is not None and drawn.setdefault(id(mtext), mtext))
+    lines: set[str] = set()
+
+    def record(s, ismath, mtext):
+        if mtext is not None:
+            drawn.setdefault(id(mtext), mtext)
+        elif s.strip():
+            lines.add(" ".join(s.split()))
+
+    renderer = _draw_calling(fig, record)
+    for text in fig.findobj(Text):
+        words = " ".join(text.get_text().split())
+        if id(text) not in drawn and text.get_visible() and any(words.startswith(line) for line in lines):
+            drawn[id(text)] = text
     return list(drawn.values()), renderer
 
 

@@ -19,7 +19,6 @@ import contextlib
 import io
 import json
 import re
-import sys
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -27,6 +26,7 @@ import pytest
 
 from coursekit.tools.chapters import chapter_notebooks
 from coursekit.exercises._feedback import CheckResult
+from kernels import this_python_kernel
 
 NOTEBOOKS = chapter_notebooks(Path(__file__).resolve().parents[1] / "notebooks")
 SUMMARY = "Solution (try the exercise first)"
@@ -142,19 +142,6 @@ def test_unanswered_exercises_say_not_yet_and_every_solution_is_correct(path):
     assert checked == sum(map(_is_exercise_cell, cells)) >= 4
 
 
-def _this_python_kernel():
-    """A kernel manager that starts ipykernel with this interpreter (whatever kernels are installed)."""
-    from jupyter_client.kernelspec import KernelSpec, KernelSpecManager
-    from jupyter_client.manager import KernelManager
-
-    class ThisPython(KernelSpecManager):
-        def get_kernel_spec(self, kernel_name):
-            return KernelSpec(argv=[sys.executable, "-m", "ipykernel_launcher", "-f", "{connection_file}"],
-                              display_name="this Python", language="python")
-
-    return KernelManager(kernel_name="python3", kernel_spec_manager=ThisPython())
-
-
 def test_run_all_in_a_kernel_leaves_no_out_line_and_answers_nothing():
     """The exercise cells of all notebooks in one kernel, then one right answer: no execute_result
     (but for the progress table each notebook ends with)."""
@@ -166,7 +153,7 @@ def test_run_all_in_a_kernel_leaves_no_out_line_and_answers_nothing():
         sources += [_imports(cells)] + [c.source for c in cells if c.kind == "code" and c.exercise]
     sources.append("ex.check_stability([True, False, False, True])")   # a right answer, on the last line
     nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in sources])
-    NotebookClient(nb, km=_this_python_kernel(), timeout=120).execute()
+    NotebookClient(nb, km=this_python_kernel(), timeout=120).execute()
     outputs = [(cell.source, out) for cell in nb.cells for out in cell.outputs]
     shows_progress = [s for s in sources if s.startswith("ex.progress(")]   # the last cell of each notebook
     assert len(shows_progress) == len(NOTEBOOKS)

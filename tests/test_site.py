@@ -9,7 +9,9 @@ of each thing the site treats specially (skipped, with the reason, without the `
 from __future__ import annotations
 
 import base64
+import hashlib
 import html
+import json
 import os
 import re
 import subprocess
@@ -267,6 +269,14 @@ def test_small_build_instructor_site(tmp_path):
     alts = re.findall(r'<img[^>]*alt="([^"]*)"', page)
     assert any("bump: starts at 0, highest 3 at time t [s] = 1" in html.unescape(a) for a in alts), alts
     assert "explorer (static figure)" in [html.unescape(a) for a in alts] and not any("_images/" in a for a in alts)
+    # the smallest text of every figure recorded by its image (the browser test measures it); the
+    # stand-in for an explorer is no figure: nothing to record
+    record = json.loads((out / "_static" / site.FIGURE_RECORD).read_text(encoding="utf-8"))["smallest_text_pt"]
+    images = {src: hashlib.sha256((out / src).read_bytes()).hexdigest()
+              for src in re.findall(r'<img[^>]*src="(_images/[^"]*)"', page)}
+    sizes = [record.get(digest) for digest in images.values()]
+    assert len(sizes) == 2 and 10.0 in sizes and None in sizes, (images, record)
+    assert site.SMALLEST_TEXT not in page and site.ALT not in page
     # no setup cell, placeholder or build-machine output; the notebook to download, stored clean
     assert "OWNER/NAME" not in page and "BUILD-MACHINE-VERSIONS" not in page
     assert "Run online" not in index.read_text(encoding="utf-8")     # no repository address yet

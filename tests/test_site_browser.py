@@ -8,12 +8,17 @@ request to any host but 127.0.0.1 (each is recorded and aborted, so the site mus
 network), a broken image, an equation MathJax did not typeset (or TeX left in the text), an
 explorer without its figure or with a widget area, a missing or unstyled erratum box, section
 numbers other than the notebook's own, a solution that is not folded (instructor) or that is
-present at all (student). Skipped, with the reason, without Playwright, Chromium or the site extra.
+present at all (student). At a window 1,280 px wide, the smallest text of every figure is shown at
+11 CSS px at least: its size in points, which the build records for each image, times the image's
+pixels per point, times the scale the browser shows it at. Skipped, with the reason, without
+Playwright, Chromium or the site extra.
 """
 
 from __future__ import annotations
 
+import hashlib
 import html
+import json
 import re
 import socket
 import subprocess
@@ -24,6 +29,7 @@ from pathlib import Path
 
 import nbformat
 import pytest
+from PIL import Image
 
 from coursekit.tools import site
 from coursekit.tools.chapters import chapter_notebooks
@@ -111,8 +117,8 @@ def browser(built):
 class Visit:
     """One page opened with every outside request refused and every error recorded."""
 
-    def __init__(self, browser, url: str):
-        self.context = browser.new_context(viewport={"width": 1300, "height": 900})
+    def __init__(self, browser, url: str, width: int = 1300):
+        self.context = browser.new_context(viewport={"width": width, "height": 900})
         self.outside, self.errors = [], []
         self.context.route("**/*", self._route)
         self.page = self.context.new_page()
@@ -140,8 +146,8 @@ class Visit:
 def visit(browser):
     opened = []
 
-    def open_page(url):
-        opened.append(Visit(browser, url))
+    def open_page(url, width=1300):
+        opened.append(Visit(browser, url, width))
         return opened[-1]
 
     yield open_page
@@ -172,6 +178,13 @@ PAGE_REPORT = """() => {
 EXPLORER_REPORT = """() => [...document.querySelectorAll('.cell')]
   .filter(c => /\\b\\w+_explorer\\(/.test((c.querySelector('.cell_input') || {}).textContent || ''))
   .map(c => [...c.querySelectorAll('.cell_output img')].filter(i => i.naturalWidth >= 200).length)"""
+
+#: the window width at which the site's figures show their smallest text at `SMALLEST_TEXT_PX`
+FIGURE_WINDOW = 1280
+SMALLEST_TEXT_PX = 11.0
+
+FIGURE_REPORT = """() => [...document.querySelectorAll('article img')].map(i => ({
+  src: i.getAttribute('src'), natural: i.naturalWidth, shown: i.getBoundingClientRect().width}))"""
 
 ERRATUM_REPORT = """() => [...document.querySelectorAll('div.erratum.admonition')].map(box => ({
   title: box.querySelector('.admonition-title').textContent.trim(),
@@ -261,6 +274,31 @@ def _check_chapter(v, name: str, report: dict) -> None:
     for box in boxes:
         assert re.match(r"(Remark / )?[Ee]rratum", box["title"]) and box["height"] > 30, box
         assert box["background"] == ERRATUM_BACKGROUND, box
+
+
+@pytest.mark.parametrize("edition", EDITIONS)
+@pytest.mark.parametrize("name", CHAPTERS)
+def test_figure_text_is_11_css_px_or_more_in_a_1280_px_window(name, edition, built, server, visit):
+    folder = built[edition]
+    record = json.loads((folder / "_static" / site.FIGURE_RECORD).read_text(encoding="utf-8"))["smallest_text_pt"]
+    v = visit(f"{server}/{edition}/{name}.html", width=FIGURE_WINDOW)
+    images = v.page.evaluate(FIGURE_REPORT)
+    assert images, "a chapter page without a figure"
+    small, unknown = [], []
+    for image in images:
+        path = folder / image["src"]
+        points = record.get(hashlib.sha256(path.read_bytes()).hexdigest())
+        if points is None:
+            unknown.append(image["src"])
+            continue
+        with Image.open(path) as png:
+            pixels_per_point = png.info["dpi"][0] / 72
+        shown = points * pixels_per_point * image["shown"] / image["natural"]
+        if shown < SMALLEST_TEXT_PX:
+            small.append(f"{image['src']}: {points:g} pt at {pixels_per_point * 72:.0f} dpi, shown "
+                         f"{image['shown']:.0f} of {image['natural']} px wide: {shown:.1f} CSS px")
+    assert not unknown, f"images without a recorded smallest text: {unknown}"
+    assert not small, "figure text below 11 CSS px:\n" + "\n".join(small)
 
 
 @pytest.mark.parametrize("name", CHAPTERS)

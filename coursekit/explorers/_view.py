@@ -112,7 +112,7 @@ _CSS = r"""
 .ck-explorer .ck-controls > .widget-dropdown > .widget-label { width: 100% !important; max-width: none;
   text-align: left; line-height: 1.3; }
 .ck-explorer .ck-readout { font-variant-numeric: tabular-nums; line-height: 1.4; min-height: 2.8em; }
-.ck-explorer .ck-error { color: #b00020; }
+.ck-explorer .ck-error { color: var(--jp-error-color1, #b00020); }  /* 5:1 in the light and dark themes */
 .ck-explorer .ck-figure-view img.ck-explorer-figure { max-width: none; display: block; }
 .ck-explorer .ck-live { position: absolute; width: 1px; height: 1px; overflow: hidden;
   clip-path: inset(50%); white-space: nowrap; }

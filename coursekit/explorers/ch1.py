@@ -14,6 +14,7 @@ from ..realization import euler_discretize
 from ..simulation import simulate
 from ..systems import StateSpace
 from ..stability import format_poles
+from ..style import PALETTE, course_subplots, curve_style
 from ._base import Explorer, dropdown, rescale, slider
 
 __all__ = ["EULER_EXAMPLES", "euler_compute", "euler_explorer", "msd_compute", "msd_explorer"]
@@ -68,10 +69,11 @@ def euler_compute(Ts: float, example: str = "first order (1.12)", samples: int =
 def euler_explorer() -> Explorer:
     """Sliders for the Euler step Ts: exact solution, Euler samples and error."""
     def draw(fig):
-        ax, ax_err = fig.subplots(2, 1, sharex=True)
-        exact, = ax.plot([], [], "k", linewidth=2, label="exact")
-        approx, = ax.plot([], [], "o--", markersize=3, linewidth=0.8, color="C1", label="Euler (1.43)")
-        err, = ax_err.semilogy([], [], color="C1")
+        ax, ax_err = course_subplots(fig, 2, 1, sharex=True)
+        euler = curve_style(1)            # dashed vermillion, with points while they can be told apart
+        exact, = ax.plot([], [], color=PALETTE["black"], linewidth=2, label="exact")
+        approx, = ax.plot([], [], marker="o", markersize=3, linewidth=0.8, label="Euler (1.43)", **euler)
+        err, = ax_err.semilogy([], [], **euler)
         ax.set_ylabel("x1")
         ax.set_title("first state: exact and Euler samples")
         ax.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
@@ -142,15 +144,15 @@ def msd_compute(m: float, d: float, k: float, experiment: str = "step", t_end: f
 def msd_explorer() -> Explorer:
     """Sliders for m, d, k of the mass-spring-damper: response and poles."""
     def draw(fig):
-        ax, ax_p = fig.subplots(1, 2, width_ratios=[2.2, 1])
-        y, = ax.plot([], [], label="position y [m]")
-        v, = ax.plot([], [], label="velocity y' [m/s]")
+        ax, ax_p = course_subplots(fig, 1, 2, width_ratios=[2.2, 1])
+        y, = ax.plot([], [], label="position y [m]", **curve_style(0))
+        v, = ax.plot([], [], label="velocity y' [m/s]", **curve_style(1))
         ax.set_xlabel("time t [s]")
         ax.set_ylabel("y [m], y' [m/s]")
         ax.set_title("response")
         ax.legend(loc="best", fontsize="small")
         ax.grid(True, alpha=0.4)
-        poles, = ax_p.plot([], [], "x", markersize=10, markeredgewidth=2, color="C3")
+        poles, = ax_p.plot([], [], "x", markersize=10, markeredgewidth=2, color=PALETTE["vermillion"])
         ax_p.axvline(0, color="0.5", linewidth=0.8)
         ax_p.axhline(0, color="0.5", linewidth=0.8)
         ax_p.set_xlabel("Re s [1/s]")

@@ -12,6 +12,7 @@ from .. import models
 from .._validation import as_scalar, as_series, as_time_grid, as_vector, time_grid
 from ..flatness import plan_robot
 from ..simulation import simulate
+from ..style import PALETTE, course_subplots, curve_style
 from ..trajectory import feedforward, poly_trajectory
 from ._base import Explorer, int_slider, rescale, slider
 
@@ -61,13 +62,13 @@ def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0
 def planner_explorer() -> Explorer:
     """Sliders for the horizon T, the target and a mass error: y_d, u_d and the simulated y."""
     def draw(fig):
-        ax_y, ax_u = fig.subplots(2, 1, sharex=True)
-        yd, = ax_y.plot([], [], "k--", label="planned y_d")
-        y, = ax_y.plot([], [], color="C0", label="simulated y")
+        ax_y, ax_u = course_subplots(fig, 2, 1, sharex=True)
+        yd, = ax_y.plot([], [], color=PALETTE["black"], linestyle="--", label="planned y_d")
+        y, = ax_y.plot([], [], label="simulated y", **curve_style(0))
         ax_y.set_ylabel("position y [m]")
         ax_y.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
         ax_y.grid(True, alpha=0.4)
-        ud, = ax_u.plot([], [], color="C1", label="u_d (2.30),\nheld at k y(T)\nafter T")
+        ud, = ax_u.plot([], [], label="u_d (2.30),\nheld at k y(T)\nafter T", **curve_style(1))
         ax_u.set_ylabel("force u [N]")
         ax_u.set_xlabel("time t [s]")
         ax_u.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
@@ -179,10 +180,11 @@ def _arrow_tip(points, tx: float, ty: float, th: float) -> np.ndarray:
 def robot_planner_explorer() -> Explorer:
     """Sliders for the target pose: planned path (flatness) and the path the robot drives."""
     def draw(fig):
-        ax, ax_u = fig.subplots(1, 2, width_ratios=[1.3, 1])
-        path, = ax.plot([], [], "k--", label="planned path F_d")
-        driven, = ax.plot([], [], color="C0", alpha=0.8, label="driven (model 1.10)")
-        goal = ax.quiver([0.0], [0.0], [1.0], [0.0], color="C3", scale=12, label="target pose", zorder=3)
+        ax, ax_u = course_subplots(fig, 1, 2, width_ratios=[1.3, 1])
+        path, = ax.plot([], [], color=PALETTE["black"], linestyle="--", label="planned path F_d")
+        driven, = ax.plot([], [], alpha=0.8, label="driven (model 1.10)", **curve_style(0))
+        goal = ax.quiver([0.0], [0.0], [1.0], [0.0], color=PALETTE["vermillion"], scale=12, label="target pose",
+                         zorder=3)
         # an unseen line along the arrow, so the legend's "best" place keeps clear of all of it
         shaft, = ax.plot([], [], alpha=0.0, label="_arrow")
         ax.plot([0], [0], "ko")
@@ -192,8 +194,8 @@ def robot_planner_explorer() -> Explorer:
         ax.set_title("path in the plane")
         ax.legend(loc="best", fontsize="small")
         ax.grid(True, alpha=0.4)
-        u1, = ax_u.plot([], [], label="speed u1 [m/s]")
-        u2, = ax_u.plot([], [], label="turn rate u2 [rad/s]")
+        u1, = ax_u.plot([], [], label="speed u1 [m/s]", **curve_style(0))
+        u2, = ax_u.plot([], [], label="turn rate u2 [rad/s]", **curve_style(1))
         for line in (u1, u2):
             line.sticky_edges.x.append(0.0)    # time starts at 0: no room before it
         ax_u.set_xlabel("time t [s]")

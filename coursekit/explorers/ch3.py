@@ -18,6 +18,7 @@ from ..placement import place
 from ..simulation import simulate, simulate_batch
 from ..systems import StateSpace
 from ..stability import format_poles
+from ..style import PALETTE, course_subplots, curve_style
 from ._base import Explorer, rescale, slider
 
 __all__ = [
@@ -83,10 +84,10 @@ def pole_placement_compute(wn: float = 2.0, zeta: float = 0.7, p3: float = -3.0,
 def pole_placement_explorer() -> Explorer:
     """Sliders for a pole pair (wn, zeta) and a real pole: K, pole plot, x(t) and u(t)."""
     def draw(fig):
-        ax_p, ax_x, ax_u = fig.subplots(1, 3, width_ratios=[1, 1.3, 1.3])
-        stable = ax_p.axvspan(-1e3, 0, color="tab:green", alpha=0.12, label="stable (Re < 0)")
-        ol, = ax_p.plot([], [], "x", color="C3", ms=10, mew=2, label="open loop eig(A)")
-        cl, = ax_p.plot([], [], "o", color="C0", ms=10, mew=2, fillstyle="none",
+        ax_p, ax_x, ax_u = course_subplots(fig, 1, 3, width_ratios=[1, 1.3, 1.3])
+        stable = ax_p.axvspan(-1e3, 0, color=PALETTE["bluish green"], alpha=0.12, label="stable (Re < 0)")
+        ol, = ax_p.plot([], [], "x", color=PALETTE["vermillion"], ms=10, mew=2, label="open loop eig(A)")
+        cl, = ax_p.plot([], [], "o", color=PALETTE["blue"], ms=10, mew=2, fillstyle="none",
                         label="closed loop eig(A + B K)")
         ax_p.axhline(0, color="0.5", lw=0.8)
         ax_p.axvline(0, color="0.5", lw=0.8)
@@ -94,10 +95,10 @@ def pole_placement_explorer() -> Explorer:
                  title="poles")
         # below the figure, where it hides no pole whatever the sliders say
         fig.legend(handles=[stable, ol, cl], loc="outside lower center", ncols=3, fontsize="small")
-        xs = [ax_x.plot([], [], label=f"x{i + 1}")[0] for i in range(3)]
+        xs = [ax_x.plot([], [], label=f"x{i + 1}", **curve_style(i))[0] for i in range(3)]
         ax_x.set(xlabel="time t [s]", ylabel="state x (dimensionless)", title="response from x0 = [1, 0, 0]")
         ax_x.legend(loc="best", fontsize="small")
-        u, = ax_u.plot([], [], color="C4", label="u = K x")
+        u, = ax_u.plot([], [], color=PALETTE["black"], label="u = K x")
         ax_u.set(xlabel="time t [s]", ylabel="control effort u", title="control effort u(t)")
         ax_u.legend(loc="best", fontsize="small")
         for ax in (ax_p, ax_x, ax_u):
@@ -194,13 +195,13 @@ def upright_pendulum_compute(theta0_deg: float = 30.0, pole: float = -2.0, u_max
 def upright_pendulum_explorer() -> Explorer:
     """Sliders for the initial angle and the pole speed: linear vs feedback-linearizing control."""
     def draw(fig):
-        ax_th, ax_u = fig.subplots(1, 2)
-        lin, = ax_th.plot([], [], color="C0", label="linear u = K(x - x*) (3.92)")
-        fl, = ax_th.plot([], [], color="C1", ls="--", label="feedback linearizing (3.154)")
+        ax_th, ax_u = course_subplots(fig, 1, 2)
+        lin, = ax_th.plot([], [], label="linear u = K(x - x*) (3.92)", **curve_style(0))
+        fl, = ax_th.plot([], [], label="feedback linearizing (3.154)", **curve_style(1))
         ax_th.axhline(0, color="0.5", lw=0.8)
         ax_th.set(xlabel="time t [s]", ylabel="theta - pi [deg]", title="angle from upright")
-        ulin, = ax_u.plot([], [], color="C0")
-        ufl, = ax_u.plot([], [], color="C1", ls="--")
+        ulin, = ax_u.plot([], [], **curve_style(0))
+        ufl, = ax_u.plot([], [], **curve_style(1))
         ax_u.set(xlabel="time t [s]", ylabel="torque u [N m]", title="control torque")
         # one legend for both axes, below them, where it hides no curve
         fig.legend(handles=[lin, fl], loc="outside lower center", ncols=2, fontsize="small")
@@ -269,15 +270,16 @@ def integral_action_compute(d: float = 1.0, integral_pole: float = -1.0, t_end: 
 def integral_action_explorer() -> Explorer:
     """Sliders for the disturbance size and the integral pole: offset with and without integrator."""
     def draw(fig):
-        ax_y, ax_u = fig.subplots(1, 2)
-        plain, = ax_y.plot([], [], color="C0", label="state feedback u = K x (offset 3.109)")
-        integ, = ax_y.plot([], [], color="C2", label="with integral action u = K x + k_I int x1 (3.117)")
-        off = ax_y.axhline(0, color="C0", ls=":", label="predicted offset (3.109)")
+        ax_y, ax_u = course_subplots(fig, 1, 2)
+        plain_style, integral_style = curve_style(0), curve_style(1)
+        plain, = ax_y.plot([], [], label="state feedback u = K x (offset 3.109)", **plain_style)
+        integ, = ax_y.plot([], [], label="with integral action u = K x + k_I int x1 (3.117)", **integral_style)
+        off = ax_y.axhline(0, color=PALETTE["blue"], ls=":", label="predicted offset (3.109)")
         ax_y.axvline(1.0, color="0.5", ls="--", lw=0.8)
-        ax_y.set(xlabel="time t [s]", ylabel="output y = x1", title="output after the disturbance (dashed: t = 1 s)")
-        uplain, = ax_u.plot([], [], color="C0")
-        uint, = ax_u.plot([], [], color="C2")
-        ax_u.set(xlabel="time t [s]", ylabel="control input u", title="control input (integral action ends at u = -d)")
+        ax_y.set(xlabel="time t [s]", ylabel="output y = x1", title="output after the disturbance at t = 1 s")
+        uplain, = ax_u.plot([], [], **plain_style)
+        uint, = ax_u.plot([], [], **integral_style)
+        ax_u.set(xlabel="time t [s]", ylabel="control input u", title="input u (integral action ends at -d)")
         # one legend for both axes, below them, where it hides no curve
         fig.legend(handles=[plain, integ, off], loc="outside lower center", ncols=2, fontsize="small")
         for ax in (ax_y, ax_u):

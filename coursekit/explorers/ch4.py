@@ -19,6 +19,7 @@ from ..observability import place_observer
 from ..observers import observer_system
 from ..simulation import simulate
 from ..stability import format_poles
+from ..style import PALETTE, course_subplots, curve_style
 from ._base import Explorer, rescale, slider
 
 __all__ = ["KALMAN_TRUE_Q", "KALMAN_TRUE_R", "observer_noise_compute", "observer_noise_explorer", "kalman_tuning_compute",
@@ -76,12 +77,13 @@ def observer_noise_compute(speed: float, noise_std: float, *, seed: int = 0, t_e
 
 def _two_state_axes(fig):
     """Position (with the noisy GPS samples) above velocity: truth and estimate."""
-    ax_p, ax_v = fig.subplots(2, 1, sharex=True)
-    meas, = ax_p.plot([], [], ".", markersize=2, color="0.6", label="GPS y (noisy)")
-    true_p, = ax_p.plot([], [], "k", linewidth=1.5, label="true position x1")
-    est_p, = ax_p.plot([], [], color="C1", linewidth=1.2, label="estimate x̂1")
-    true_v, = ax_v.plot([], [], "k", linewidth=1.5, label="true velocity x2")
-    est_v, = ax_v.plot([], [], color="C1", linewidth=1.2, label="estimate x̂2")
+    ax_p, ax_v = course_subplots(fig, 2, 1, sharex=True)
+    truth, estimate = dict(color=PALETTE["black"], linewidth=1.5), dict(linewidth=1.2, **curve_style(1))
+    meas, = ax_p.plot([], [], ".", markersize=2, color="0.5", label="GPS y (noisy)")
+    true_p, = ax_p.plot([], [], label="true position x1", **truth)
+    est_p, = ax_p.plot([], [], label="estimate x̂1", **estimate)
+    true_v, = ax_v.plot([], [], label="true velocity x2", **truth)
+    est_v, = ax_v.plot([], [], label="estimate x̂2", **estimate)
     ax_p.set_ylabel("position [m]")
     ax_p.set_title("true state and estimate")
     ax_v.set_ylabel("velocity [m/s]")

@@ -3,7 +3,8 @@
 * `chapters` finds the chapters (notebooks, explorer and exercise modules); `cells` names the
   roles of a notebook's cells that the other tools read;
 * `release` writes the student edition, `slides` the slide metadata, `colab` the install cell;
-* `site` builds the course website, `grading` grades submitted notebooks.
+* `site` builds the course website (`site_figures` draws its figures for the page), `grading`
+  grades submitted notebooks.
 
 ``python -m coursekit --help`` lists the commands that call them.
 """

@@ -6,7 +6,10 @@ directory and needs no network:
 1. copy the chapter notebooks (for ``student=True`` the student edition: solutions removed);
 2. execute each one with nbclient, without storing widget state, and drop the widget views
    from the outputs, so every explorer shows its static ``image/png`` figure (the figure for
-   the default slider values) instead of an empty widget area;
+   the default slider values) instead of an empty widget area; the kernel draws every figure
+   for the page's column, so that its smallest text is 11 CSS px or more at a 1,280-px window,
+   describes it for its ``alt`` and notes the size of its smallest text, which the site
+   records in ``_static/coursekit-figures.json`` (`coursekit.tools.site_figures`);
 3. rewrite the erratum paragraphs of the markdown cells into admonitions styled as boxes, and
    fold the old-style solution code cells behind a "Show solution" click (solutions written as
    markdown ``<details>`` blocks fold by themselves);
@@ -23,6 +26,7 @@ from __future__ import annotations
 
 import concurrent.futures
 import importlib.util
+import json
 import multiprocessing
 import os
 import re
@@ -48,6 +52,7 @@ __all__ = [
     "for_the_site",
     "run_online",
     "describe_images",
+    "figure_text_sizes",
 ]
 
 WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
@@ -427,17 +432,18 @@ def _prepare(path: Path, src: Path, *, student: bool, timeout: int) -> dict:
     (src / "downloads").mkdir(exist_ok=True)
     nbformat.write(nb, src / "downloads" / path.name)       # the notebook as a reader downloads it
     nb = for_the_site(nb, path.name, repository=repository_of(nb))
-    nb.cells.insert(0, nbformat.v4.new_code_cell(DESCRIBE_FIGURES))
+    nb.cells.insert(0, nbformat.v4.new_code_cell(SITE_FIGURES))
     _execute(nb, cwd=path.parent, timeout=timeout, name=path.name)
     nb.cells.pop(0)
     describe_images(nb)
+    sizes = figure_text_sizes(nb)
     strip_widget_views(nb)
     fold_solution_code(nb)
     for cell in nb.cells:
         if cell.cell_type == "markdown":
             cell.source = erratum_admonitions(_source(cell))
     nbformat.write(nb, src / path.name)
-    return chapter_entry(nb, path.stem)
+    return {**chapter_entry(nb, path.stem), "smallest_text_pt": sizes}
 
 
 def repository_of(nb) -> str | None:
@@ -461,22 +467,17 @@ def for_the_site(nb, name: str, *, repository: str | None = None):
 
 #: the media type under which the kernel adds each figure's description to its display data
 ALT = "text/x-coursekit-alt"
+#: the media type under which it adds the size of each figure's smallest text, in points
+SMALLEST_TEXT = "text/x-coursekit-smallest-text-pt"
+#: the file of the site, under ``_static``, that gives the size in points of the smallest text of
+#: each image (``{"smallest_text_pt": {sha256 of the PNG: size}}``)
+FIGURE_RECORD = "coursekit-figures.json"
 
-#: run first in each notebook the site executes: every matplotlib figure displayed carries its
-#: description (`coursekit.describe_figure`), from a display formatter that asks each object for
-#: it by a method name (the inline backend resets the formatters' figure types when switched on)
-DESCRIBE_FIGURES = f"""\
-from IPython.core.formatters import BaseFormatter as _Base
-from traitlets import ObjectName as _Name
-import coursekit as _ck
-import matplotlib.figure as _figure
-class _Alt(_Base):
-    format_type = {ALT!r}
-    print_method = _Name("_coursekit_alt_")
-_figure.Figure._coursekit_alt_ = _ck.describe_figure
-_shell = get_ipython()
-_shell.display_formatter.formatters[{ALT!r}] = _Alt(parent=_shell.display_formatter)
-_shell.display_formatter.active_types = [*_shell.display_formatter.active_types, {ALT!r}]
+#: run first in each notebook the site executes: figures and explorers drawn for the page's
+#: column, each with its description and the size of its smallest text (see `site_figures`)
+SITE_FIGURES = """\
+import coursekit.tools.site_figures as _site_figures
+_site_figures.install(get_ipython())
 """
 
 
@@ -495,6 +496,22 @@ def describe_images(nb):
             mystnb = cell.metadata.setdefault("mystnb", {})
             mystnb["image"] = {**mystnb.get("image", {}), "alt": " ".join(texts)}
     return nb
+
+
+def figure_text_sizes(nb) -> dict[str, float]:
+    """Remove the `SMALLEST_TEXT` data from the outputs of `nb` (in place) and return them as
+    {SHA-256 of the output's PNG: size in points of the smallest text of that image}."""
+    import base64
+    import hashlib
+    sizes = {}
+    for cell in nb.cells:
+        for output in cell.get("outputs", []):
+            data = output.get("data", {})
+            size = _source({"source": data.pop(SMALLEST_TEXT, "None")})
+            if size != "None" and "image/png" in data:
+                png = base64.b64decode(_source({"source": data["image/png"]}))
+                sizes[hashlib.sha256(png).hexdigest()] = float(size)
+    return sizes
 
 
 def _execute(nb, *, cwd: Path, timeout: int, name: str) -> None:
@@ -516,6 +533,9 @@ def _write_sources(src: Path, chapters: list[dict], *, student: bool, repository
     (src / "_static").mkdir()
     (src / "_static" / "coursekit.css").write_text(CSS, encoding="utf-8")
     (src / "_static" / "coursekit.js").write_text(JS, encoding="utf-8")
+    record = {digest: size for chapter in chapters for digest, size in chapter.get("smallest_text_pt", {}).items()}
+    (src / "_static" / FIGURE_RECORD).write_text(json.dumps({"smallest_text_pt": record}, indent=1),
+                                                 encoding="utf-8")
 
 
 def run_online(repository: str | None) -> str:
