@@ -105,6 +105,19 @@ def test_the_checks_catch_colour_alone_off_palette_colours_and_faint_text():
     assert any("'t = 0'" in p for p in faint) and any("'a title'" in p for p in faint)
 
 
+def test_an_explorer_s_draw_with_plain_subplots_gets_the_course_style():
+    from coursekit.explorers import Explorer, slider
+
+    def draw(fig):
+        ax = fig.subplots()
+        return [ax.plot([0, 1], [0, k], label=f"curve {k}")[0] for k in (1, 2)]
+    e = Explorer(title="two curves", controls=dict(a=slider(1.0, 0.0, 2.0, 0.1, "a [-]")),
+                 compute=lambda a: a, draw=draw, update=lambda h, r: None)
+    e.fig.axes[0].legend()
+    assert style_problems(e.fig) == []
+    assert [to_hex(line.get_color()) for line in e.handles] == [to_hex(s["color"]) for s in ck.CURVE_STYLES[:2]]
+
+
 def test_the_same_figure_in_the_course_style_passes():
     fig, ax = ck.new_figure()
     ax.plot([0, 1], [0, 1], label="first")

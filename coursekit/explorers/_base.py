@@ -184,10 +184,10 @@ class Explorer:
     def __init__(self, *, title: str, controls: dict[str, Any], compute: Callable[..., Any],
                  draw: Callable[[Any], Any], update: Callable[[Any, Any], None],
                  readout: Callable[[Any], str] | None = None, figsize=None):
-        from matplotlib import rcParams
+        from matplotlib import rc_context, rcParams
         from matplotlib.figure import Figure
 
-        from ..style import fit_margins, is_lecture_mode
+        from ..style import COURSE_STYLE, fit_margins, is_lecture_mode
         self._check(title, controls, dict(compute=compute, draw=draw, update=update, readout=readout))
         self.title, self.controls = title, dict(controls)
         self._compute, self._update, self._readout = compute, update, readout
@@ -195,7 +195,8 @@ class Explorer:
         self.lecture = is_lecture_mode()
         self.fig = fit_margins(Figure(figsize=figsize or rcParams["figure.figsize"]))
         self.natural_dpi = float(self.fig.dpi)
-        self.handles = draw(self.fig)
+        with rc_context(COURSE_STYLE):     # the course's colours and a line style per curve
+            self.handles = draw(self.fig)
         self.screen: dict = {}
         self.error: str | None = None
         try:
@@ -271,10 +272,9 @@ class Explorer:
         self._send()
 
     def _moved(self) -> None:
-        """A control moved. In a kernel (an event loop runs) the frame is drawn with limits that
-        only grow (`rescale`), and a frame with fitted limits follows once the controls have
-        rested `SETTLE_S` seconds (it sends nothing when it is the frame shown); elsewhere the
-        frame is fitted at once."""
+        """A control moved. In a kernel (an event loop runs) the limits only grow (`rescale`), and
+        a frame with fitted limits follows once the controls rest `SETTLE_S` seconds (it sends
+        nothing when it is the frame shown); elsewhere the frame is fitted at once."""
         loop = self._home.loop
         if loop is None or not loop.is_running():
             return self.refresh()
