@@ -50,17 +50,25 @@ def _run_release(args) -> int:
 
 def _add_slides(commands) -> None:
     parser = commands.add_parser(
-        "slides", help="set the slide metadata of the notebooks (for nbconvert --to slides)",
-        description="Give every cell of the course notebooks its slide type, so that "
-                    "'jupyter nbconvert --to slides' makes one slide per section (## heading) and a "
-                    "sub-slide per subsection (### heading) and per paragraph with its code. Rewrites "
-                    "the notebooks in place; --check only reports the notebooks that are out of date. "
-                    "With --kernel-metadata, also stores the kernel metadata JupyterLab writes when it "
-                    "opens a notebook with this environment's python3 kernel (its Python version "
-                    "included), so that a notebook opened and closed untouched asks nothing.")
+        "slides", help="build every chapter's slides (--out DIR), or set the notebooks' slide metadata",
+        description="With --out DIR: execute every chapter notebook and write it as a reveal.js slide "
+                    "show into DIR, with an index page linking the chapters; reveal.js and MathJax are "
+                    "copied into DIR, so the slides work offline (open DIR/index.html). Explorers show "
+                    "their figure for the default slider values. Needs the slides extra: python -m pip "
+                    "install -e \".[slides]\". Without --out: give every cell of the notebooks its slide "
+                    "type (one slide per section, ## heading; a sub-slide per subsection, ### heading, "
+                    "and per paragraph with its code), rewriting them in place; --check only reports the "
+                    "notebooks that are out of date. With --kernel-metadata, also store the kernel "
+                    "metadata JupyterLab writes when it opens a notebook with this environment's python3 "
+                    "kernel (its Python version included), so that a notebook opened and closed "
+                    "untouched asks nothing.")
     parser.add_argument("--notebooks", type=Path, default=None, metavar="DIR",
                         help="folder of the notebooks (default: the repository's notebooks/)")
-    parser.add_argument("--check", action="store_true",
+    action = parser.add_mutually_exclusive_group()
+    action.add_argument("--out", type=Path, default=None, metavar="DIR",
+                        help="build the slides into DIR (created when missing; earlier slides there are "
+                             "replaced, any other non-empty folder is refused)")
+    action.add_argument("--check", action="store_true",
                         help="change nothing; exit with status 1 when a notebook's slide metadata (and, "
                              "with --kernel-metadata, its kernel metadata) is out of date")
     parser.add_argument("--kernel-metadata", action="store_true",
@@ -70,6 +78,8 @@ def _add_slides(commands) -> None:
 
 
 def _run_slides(args) -> int:
+    if args.out is not None:
+        return _build_slides(args)
     from .tools.slides import apply_slide_metadata
     changed = apply_slide_metadata(args.notebooks, write=not args.check)
     if args.check:
@@ -94,6 +104,13 @@ def _run_kernel_metadata(args) -> list:
         print(f"kernel metadata of Python {python} stored in {len(changed)} notebook(s)" if changed else
               f"kernel metadata already that of Python {python}")
     return changed
+
+
+def _build_slides(args) -> int:
+    from .tools.slideshow import build_slides
+    index = build_slides(args.out, notebooks_dir=args.notebooks, verbose=True)
+    print(f"slides written to {index.parent}\nopen {index} in a browser (no network needed)")
+    return 0
 
 
 def _add_colab(commands) -> None:

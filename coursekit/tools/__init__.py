@@ -1,10 +1,10 @@
 """The course's tools, beside its algorithms: for instructors and maintainers, not for students.
 
 * `chapters` finds the chapters (notebooks, explorer and exercise modules); `cells` names the
-  roles of a notebook's cells that the other tools read;
+  roles of a notebook's cells that the other tools read; `builds` holds what the builds share;
 * `release` writes the student edition, `slides` the slide metadata, `colab` the install cell;
-* `site` builds the course website (`site_figures` draws its figures for the page), `grading`
-  grades submitted notebooks.
+* `site` builds the course website (`site_figures` draws its figures for the page), `slideshow`
+  the slides of every chapter, `grading` grades submitted notebooks.
 
 ``python -m coursekit --help`` lists the commands that call them.
 """

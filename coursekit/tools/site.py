@@ -37,7 +37,7 @@ import tempfile
 from pathlib import Path
 
 from .cells import ENVIRONMENT, INSTALL, is_solution, role
-from .chapters import chapter_notebooks
+from .builds import start_build
 
 __all__ = [
     "build_site",
@@ -69,7 +69,6 @@ JS = """document.addEventListener("DOMContentLoaded", () => {
 SITE_TOOLS = {"sphinx": "sphinx", "myst_nb": "myst-nb", "sphinx_book_theme": "sphinx-book-theme",
               "sphinx-mathjax-offline": "sphinx-mathjax-offline", "nbclient": "nbclient",
               "nbformat": "nbformat", "ipykernel": "ipykernel"}
-REPO_ROOT = Path(__file__).resolve().parents[2]
 
 # An erratum paragraph starts with a bold lead such as "**Erratum (1.1).**" or
 # "**Remark / erratum (1.9).**"; group 1 is the lead without its final period.
@@ -362,13 +361,8 @@ def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: i
     """
     if not isinstance(student, bool):
         raise TypeError(f"student must be True or False, got {student!r}")
-    if not isinstance(verbose, bool):
-        raise TypeError(f"verbose must be True or False, got {verbose!r}")
-    if not isinstance(timeout, int) or isinstance(timeout, bool) or timeout <= 0:
-        raise ValueError(f"timeout must be a positive whole number of seconds, got {timeout!r}")
-    out = Path(out_dir).resolve()
-    sources = chapter_notebooks(REPO_ROOT / "notebooks" if notebooks_dir is None else notebooks_dir)
-    _check_out_dir(out, sources)
+    out, sources = start_build(out_dir, notebooks_dir, timeout=timeout, verbose=verbose,
+                               built_before=_built_before, kind="a site")
     missing = missing_site_tools()
     if missing:
         raise RuntimeError("the site tools are not installed (" + ", ".join(missing) + "): run "
@@ -389,16 +383,9 @@ def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: i
     return out / "index.html"
 
 
-def _check_out_dir(out: Path, sources: list[Path]) -> None:
-    """Refuse an output folder whose replacement would delete anything but an earlier site."""
-    if out in [p.parent.resolve() for p in sources]:
-        raise ValueError(f"out_dir {str(out)!r} is the notebooks folder; pick an empty or new folder")
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"out_dir {str(out)!r} is a file; pick an empty or new folder")
-    earlier_site = (out / "index.html").is_file() and (out / "_static").is_dir()
-    if out.is_dir() and any(out.iterdir()) and not earlier_site:
-        raise ValueError(f"out_dir {str(out)!r} holds files that are not a site built before "
-                         "(they would be deleted); pick an empty or new folder")
+def _built_before(folder: Path) -> bool:
+    """Whether `folder` holds a site built before (which a new build may replace)."""
+    return (folder / "index.html").is_file() and (folder / "_static").is_dir()
 
 
 def _say(verbose: bool, message: str) -> None:

@@ -1,0 +1,227 @@
+"""The course's slides: ``python -m coursekit slides --out DIR`` calls :func:`build_slides`.
+
+Every chapter notebook (found by `coursekit.tools.chapters`) becomes one reveal.js slide show,
+executed, in one folder with an index page that links them. The build needs no network and
+neither do the slides:
+
+1. each notebook gets the slide types of `coursekit.tools.slides` (in memory: the notebooks
+   are not rewritten) and is executed with nbclient, the kernels side by side, without storing
+   widget state, so every explorer shows its static figure for the default slider values (the
+   slides have no kernel); each figure gets its text alternative from its data, as on the
+   website (`coursekit.tools.site.DESCRIBE_FIGURES`);
+2. nbconvert's ``SlidesExporter`` writes the slides with the template ``coursekit_reveal``
+   (shipped in this package), which extends nbconvert's reveal template and loads reveal.js and
+   MathJax 3 from the folder: no jQuery, require.js or mermaid from a CDN, no MathJax 2 (whose
+   preview spans left the first slide's equations on screen twice), and the reveal.js theme
+   ``white``, whose fonts ship with reveal.js (``simple``, nbconvert's default, loads Google
+   Fonts). MathJax typesets the slides, and only them, before reveal.js starts: reveal.js copies
+   the text of the slide shown into a live region for screen readers, and that copy must be the
+   typeset equations, not TeX for MathJax to typeset a second time. The slides are 1280 x 800
+   without the ``In [n]:`` prompts, so that a line of the notebooks' code fits;
+3. reveal.js (from the PyPI package ``sphinx-revealjs``) and MathJax 3 (from
+   ``sphinx-mathjax-offline``, which the website uses too) are copied into the folder.
+
+The tools are the optional ``slides`` extra (``pip install -e ".[slides]"``).
+"""
+
+from __future__ import annotations
+
+import asyncio
+import html
+import importlib.util
+import os
+import shutil
+import sys
+import tempfile
+from pathlib import Path
+
+from .builds import start_build
+from .site import ALT, DESCRIBE_FIGURES, WIDGET_VIEW, chapter_entry
+from .slides import with_slide_metadata
+
+__all__ = ["SLIDE_TOOLS", "TEMPLATE", "MATHJAX", "SUFFIX", "build_slides", "missing_slide_tools", "asset_folders",
+           "figure_alt_texts", "slides_exporter", "index_page"]
+
+#: import name -> pip name of what the build needs (the ``slides`` extra)
+SLIDE_TOOLS = {"nbconvert": "nbconvert", "nbclient": "nbclient", "nbformat": "nbformat",
+               "ipykernel": "ipykernel", "sphinx_revealjs": "sphinx-revealjs",
+               "sphinx-mathjax-offline": "sphinx-mathjax-offline"}
+
+#: the nbconvert template of the slides, a folder of this package
+TEMPLATE = Path(__file__).resolve().parent / "templates" / "coursekit_reveal"
+
+#: where each asset is found: (pip name, folder inside the package, a file it must hold)
+_ASSETS = {"reveal.js": ("sphinx-revealjs", "sphinx_revealjs", "_static/revealjs", "dist/reveal.js"),
+           "mathjax": ("sphinx-mathjax-offline", "sphinx-mathjax-offline", "static/mathjax",
+                       "tex-chtml-full.js")}
+
+#: the MathJax 3 component the slides load (TeX in, HTML out, every TeX extension in one file)
+MATHJAX = "mathjax/tex-chtml-full.js"
+#: a chapter's slides are NOTEBOOK_STEM + SUFFIX in the folder (nbconvert's name for them)
+SUFFIX = ".slides.html"
+_INSTALL = "python -m pip install -e \".[slides]\" from the repository root"
+
+
+def missing_slide_tools() -> list[str]:
+    """The pip names of the slide tools that are not installed (empty when all are)."""
+    return [pip_name for module, pip_name in SLIDE_TOOLS.items()
+            if importlib.util.find_spec(module) is None]
+
+
+def asset_folders() -> dict[str, Path]:
+    """``{"reveal.js": folder, "mathjax": folder}``: the installed copies the slides load."""
+    folders = {}
+    for name, (pip_name, module, inside, probe) in _ASSETS.items():
+        spec = importlib.util.find_spec(module)
+        folder = Path(spec.submodule_search_locations[0]) / inside if spec else None
+        if folder is None or not (folder / probe).is_file():
+            raise RuntimeError(f"{name} not found: the package {pip_name} is missing or does not ship "
+                               f"{inside}/{probe}; run {_INSTALL}")
+        folders[name] = folder
+    return folders
+
+
+def figure_alt_texts(nb):
+    """Give every figure of `nb` its text alternative (in place; returned).
+
+    The text goes into the output's ``metadata["image/png"]["alt"]``, which the template writes
+    into the image's ``alt``: a figure's from its described data (`ALT`, removed from the data),
+    an explorer's from its text (title, settings, readout and data).
+    """
+    for cell in nb.cells:
+        for output in cell.get("outputs", []):
+            data = output.get("data", {})
+            text = data.pop(ALT, None)
+            if text is None and "image/png" in data and WIDGET_VIEW in data:
+                text = data.get("text/plain")
+            if text and "image/png" in data:
+                alt = "".join(text) if isinstance(text, list) else text
+                output.setdefault("metadata", {}).setdefault("image/png", {})["alt"] = alt.strip()
+    return nb
+
+
+def slides_exporter():
+    """nbconvert's ``SlidesExporter`` with the course's template and the assets in the folder."""
+    from nbconvert import SlidesExporter
+    return SlidesExporter(template_name=TEMPLATE.name, extra_template_basedirs=[str(TEMPLATE.parent)],
+                          reveal_url_prefix="reveal.js", reveal_theme="white", reveal_scroll=True,
+                          exclude_input_prompt=True, exclude_output_prompt=True, mathjax_url=MATHJAX)
+
+
+def index_page(chapters: list[dict]) -> str:
+    """The index page: one link per chapter (entries of `coursekit.tools.site.chapter_entry`)."""
+    items = "\n".join(
+        f'<li><a href="{html.escape(c["page"])}{SUFFIX}">Chapter {html.escape(c["number"])}: '
+        f'{html.escape(c["title"])}</a><br>{html.escape(" · ".join(c["sections"]))}</li>'
+        for c in chapters)
+    return f"""<!DOCTYPE html>
+<html lang="en">
+<head>
+<meta charset="utf-8">
+<meta name="viewport" content="width=device-width, initial-scale=1">
+<title>State-space control: the course slides</title>
+<style>
+body {{ font-family: system-ui, sans-serif; max-width: 50em; margin: 2em auto; padding: 0 1em;
+        line-height: 1.5; color: #1a1a1a; }}
+li {{ margin-bottom: 1em; }}
+a {{ color: #0645ad; font-weight: 600; }}
+kbd {{ border: 1px solid #767676; border-radius: 3px; padding: 0 0.3em; }}
+</style>
+</head>
+<body>
+<main>
+<h1>State-space control: the course slides</h1>
+<p>One slide show per chapter of the lecture notes, executed: every figure is there, and each
+explorer shows its figure for the default values of its sliders. The slides work without a
+network.</p>
+<p>Keys: <kbd>→</kbd> next section, <kbd>↓</kbd> next part of a section (or <kbd>Space</kbd>
+for the next slide in order), <kbd>Esc</kbd> overview, <kbd>S</kbd> speaker view.</p>
+<ol>
+{items}
+</ol>
+</main>
+</body>
+</html>
+"""
+
+
+def build_slides(out_dir, *, notebooks_dir=None, timeout: int = 600, verbose: bool = False) -> Path:
+    """Build the slides of every chapter into `out_dir`; return the path of its ``index.html``.
+
+    `notebooks_dir` defaults to the repository's ``notebooks/``; `timeout` is the limit in
+    seconds for one notebook cell; `verbose=True` prints each step to stderr. `out_dir` is
+    replaced by the new slides (a folder holding anything else is refused).
+    """
+    out, sources = start_build(out_dir, notebooks_dir, timeout=timeout, verbose=verbose,
+                               built_before=_built_before, kind="slides")
+    missing = missing_slide_tools()
+    if missing:
+        raise RuntimeError(f"the slide tools are not installed ({', '.join(missing)}): run {_INSTALL}")
+    assets = asset_folders()
+    notebooks = _executed(sources, timeout=timeout, verbose=verbose)
+    with tempfile.TemporaryDirectory(prefix="coursekit-slides-") as tmp:
+        folder = Path(tmp) / "slides"
+        folder.mkdir()
+        _say(verbose, "writing the slides")
+        chapters = [_write_chapter(nb, path, folder) for nb, path in zip(notebooks, sources)]
+        for name, source in assets.items():
+            shutil.copytree(source, folder / name)
+        (folder / "index.html").write_text(index_page(chapters), encoding="utf-8")
+        if out.exists():
+            shutil.rmtree(out)
+        shutil.copytree(folder, out)
+    return out / "index.html"
+
+
+def _built_before(folder: Path) -> bool:
+    """Whether `folder` holds slides built before (which a new build may replace)."""
+    return (folder / "index.html").is_file() and all((folder / name).is_dir() for name in _ASSETS)
+
+
+def _say(verbose: bool, message: str) -> None:
+    if verbose:
+        print(f"coursekit slides: {message}", file=sys.stderr, flush=True)
+
+
+def _executed(sources: list[Path], *, timeout: int, verbose: bool) -> list:
+    """Every notebook of `sources`, with its slide types, executed (one kernel per core at a time)."""
+    import nbformat
+    notebooks = []
+    for path in sources:
+        nb = with_slide_metadata(nbformat.read(path, as_version=4))
+        nb.cells.insert(0, nbformat.v4.new_code_cell(DESCRIBE_FIGURES))
+        notebooks.append(nb)
+    workers = max(1, min(len(sources), os.cpu_count() or 1))
+    _say(verbose, f"executing {len(sources)} notebooks, {workers} at a time")
+    asyncio.run(_execute_all(notebooks, sources, timeout=timeout, workers=workers, verbose=verbose))
+    for nb in notebooks:
+        nb.cells.pop(0)
+        figure_alt_texts(nb)
+    return notebooks
+
+
+async def _execute_all(notebooks, sources, *, timeout: int, workers: int, verbose: bool) -> None:
+    from nbclient import NotebookClient
+    from nbclient.exceptions import CellExecutionError
+    gate = asyncio.Semaphore(workers)
+
+    async def run(nb, path):
+        client = NotebookClient(nb, timeout=timeout, kernel_name="python3", store_widget_state=False,
+                                resources={"metadata": {"path": str(path.parent)}})
+        async with gate:
+            try:
+                await client.async_execute()
+            except CellExecutionError as error:
+                raise RuntimeError(f"notebook {path.name} failed while building the slides:\n{error}") from None
+        _say(verbose, f"executed {path.name}")
+
+    await asyncio.gather(*(run(nb, path) for nb, path in zip(notebooks, sources)))
+
+
+def _write_chapter(nb, path: Path, folder: Path) -> dict:
+    """Write the slides of the executed notebook `nb` (read from `path`); return its index entry."""
+    entry = chapter_entry(nb, path.stem)
+    nb.metadata["title"] = f"Chapter {entry['number']}: {entry['title']}"
+    body, _ = slides_exporter().from_notebook_node(nb, resources={"metadata": {"name": path.stem}})
+    (folder / f"{path.stem}{SUFFIX}").write_text(body, encoding="utf-8")
+    return entry
