@@ -16,7 +16,10 @@ plots one line and calls ``plt.show()`` (``%matplotlib inline``, ipywidgets' def
   the Run All, before anything else touched the explorer (the "first drag"), and again after
   the steps;
 * lag after release: from mouse up to the paint of the last figure, once the figure has not
-  changed for 1 s (0 when nothing changed after the release).
+  changed for 1 s (0 when nothing changed after the release); it includes the frame that fits
+  the limits 0.3 s after the slider rests, when that frame differs;
+* CPU during that drag: seconds of CPU per second of the drag used by Chromium's processes and
+  by the kernel (of the machine's cores; the server and Playwright's driver use the rest).
 
 The floor runs before the first explorer and after every third measurement, so drift in the
 machine's speed affects both; its row pools those runs.
@@ -77,9 +80,30 @@ def measure_steps(page, slider, count: int) -> list[float]:
     return latencies
 
 
+def _cpu_seconds() -> dict:
+    """CPU seconds used so far by the processes this benchmark started: Chromium's, and the
+    kernel's (the rest: the server, Playwright's driver)."""
+    import psutil
+    used = {"chromium": 0.0, "kernel": 0.0}
+    for process in psutil.Process().children(recursive=True):
+        try:
+            with process.oneshot():
+                kind = ("chromium" if "chrom" in process.name() else
+                        "kernel" if "ipykernel" in " ".join(process.cmdline()) else None)
+                times = process.cpu_times()
+        except psutil.Error:          # ended meanwhile
+            continue
+        if kind:
+            used[kind] += times.user + times.system
+    return used
+
+
 def measure_drag(page, slider) -> dict:
-    """Figures painted per second during a 3 s drag, slider values per second, lag after release."""
+    """Figures painted per second during a 3 s drag, slider values per second, lag after release,
+    and the CPU Chromium and the kernel used per second of the drag."""
+    before, start = _cpu_seconds(), time.perf_counter()
     lab_h.drag(page, slider, seconds=DRAG_S, trips=2.5)
+    used, wall = _cpu_seconds(), time.perf_counter() - start
     state = lab_h.wait_until_quiet(page, quiet_ms=1000, timeout=90)
     down = max(i["t"] for i in state["inputs"] if i["type"] == "mousedown")
     up = max(i["t"] for i in state["inputs"] if i["type"] == "mouseup")
@@ -88,7 +112,8 @@ def measure_drag(page, slider) -> dict:
     changes = sum(a != b for a, b in zip(texts, texts[1:])) + bool(texts)
     paints = [p["t"] for p in state["paints"] if p["t"] > down]
     return {"updates": sum(t <= up for t in paints) / seconds, "values": changes / seconds,
-            "lag": max(0.0, paints[-1] - up) if paints else float("nan")}
+            "lag": max(0.0, paints[-1] - up) if paints else float("nan"),
+            **{f"cpu_{kind}": (used[kind] - before[kind]) / wall for kind in used}}
 
 
 def measure_notebook(page, url: str, name: str, scope: str, steps: int, shots: Path | None) -> dict:
@@ -174,20 +199,24 @@ def _table(explorers: list[str], kernel_ms: dict, results: dict) -> list[str]:
     floor = statistics.median(floor_steps)
     rows = ["| explorer | kernel compute + redraw | step median | step max "
             "| step / floor (target <= 1.3) | updates/s, first drag (target >= 10, light >= 20) "
-            "| updates/s, drag after the steps | slider values/s during that drag | lag after release |",
-            "|---|---|---|---|---|---|---|---|---|"]
+            "| updates/s, drag after the steps | slider values/s during that drag | lag after release "
+            "| CPU during that drag: Chromium, kernel (cores) |",
+            "|---|---|---|---|---|---|---|---|---|---|"]
     runs = results["floor"]
     rows.append(f"| floor: `interact`, one line, continuous_update=True ({len(runs)} runs) | - "
                 f"| {floor:.0f} ms | {max(floor_steps):.0f} ms | 1.00 "
                 f"| {statistics.median(r['first'] for r in runs):.1f} "
                 f"| {statistics.median(r['updates'] for r in runs):.1f} "
                 f"| {statistics.median(r['values'] for r in runs):.0f} "
-                f"| {statistics.median(r['lag'] for r in runs):.0f} ms |")
+                f"| {statistics.median(r['lag'] for r in runs):.0f} ms "
+                f"| {statistics.median(r['cpu_chromium'] for r in runs):.2f}, "
+                f"{statistics.median(r['cpu_kernel'] for r in runs):.2f} |")
     for label in explorers:
         run = results[label][0]
         ms = kernel_ms[label]
         light = " (light)" if ms <= LIGHT_MS else ""
         rows.append(f"| {label}{light} | {ms:.0f} ms | {statistics.median(run['steps']):.0f} ms "
                     f"| {max(run['steps']):.0f} ms | {statistics.median(run['steps']) / floor:.2f} "
-                    f"| {run['first']:.1f} | {run['updates']:.1f} | {run['values']:.0f} | {run['lag']:.0f} ms |")
+                    f"| {run['first']:.1f} | {run['updates']:.1f} | {run['values']:.0f} | {run['lag']:.0f} ms "
+                    f"| {run['cpu_chromium']:.2f}, {run['cpu_kernel']:.2f} |")
     return rows

@@ -287,7 +287,9 @@ ABOUT = {
                "keyboard step of the first slider against the trivial `interact` floor measured in the "
                "same session, and the figures painted per second while dragging it, right after Run All "
                "(first drag) and again after the steps. An explorer is light when its kernel compute + "
-               "redraw is at most 25 ms.",
+               "redraw is at most 25 ms. The last column shows where a drag's CPU goes: headless "
+               "Chromium without a GPU spends most of a core on the drag itself (the floor's row: a "
+               "slider and a small image), which on 2 cores bounds every row.",
     "grading": "`python -m coursekit grade` on copies of chapter 1's student edition: notebooks graded per "
                "minute with two at a time against one at a time, and grading one notebook against a plain "
                "`jupyter nbconvert --execute` of it (both start a fresh kernel).",

@@ -249,6 +249,29 @@ def test_an_explorer_in_a_kernel_grows_its_limits_during_a_drag_and_fits_them_on
     assert e.png == e.frames.frame()         # and the rested frame is the one sent
 
 
+def test_an_explorer_in_a_kernel_fits_a_single_step_at_once_in_one_frame():
+    import asyncio
+
+    async def steps():
+        e = ch1.euler_explorer()
+        e.widget
+        sent, send = [], e._send
+        e._send = lambda: (sent.append(e.png), send())
+        counts = []
+        for value in (0.3, 0.02, 0.6):       # key presses, each after the figure has settled
+            before = len(sent)
+            e.controls["Ts"].value = value
+            await asyncio.sleep(_base.SETTLE_S + 0.2)
+            counts.append(len(set(sent[before:])))
+        return counts, e
+
+    counts, e = asyncio.run(steps())
+    assert counts == [1, 1, 1]               # one frame per step: no second one to fit the limits
+    ax = e.handles["ax_err"]
+    data, view = np.log10(ax.dataLim.intervaly), np.log10(ax.get_ylim())
+    assert np.ptp(data) >= np.ptp(view) / 2  # and that frame's limits are fitted (half filled at least)
+
+
 def test_rescale_stops_at_sticky_edges_keeps_a_minimum_span_and_works_on_log_axes():
     ax = Figure().subplots()
     line, = ax.plot(np.linspace(0, 5, 11), np.full(11, 3.0))

@@ -210,7 +210,7 @@ class Explorer:
         self._widget = self._view = self._text = None
         from ._home import HomeThread
         self._home = HomeThread()
-        self._settle = None
+        self._settle, self._last_move = None, float("-inf")
         for w in self.controls.values():
             w.observe(lambda change: self._home.run(self._moved, key="refresh"), names="value")
 
@@ -272,11 +272,14 @@ class Explorer:
         self._send()
 
     def _moved(self) -> None:
-        """A control moved. In a kernel (an event loop runs) the limits only grow (`rescale`), and
-        a frame with fitted limits follows once the controls rest `SETTLE_S` seconds (it sends
-        nothing when it is the frame shown); elsewhere the frame is fitted at once."""
+        """A control moved. In a kernel (an event loop runs), while moves come less than `SETTLE_S`
+        apart (a drag) the limits only grow (`rescale`), and a frame with fitted limits follows once
+        the controls rest (it sends nothing when it is the frame shown); else it is fitted at once."""
         loop = self._home.loop
         if loop is None or not loop.is_running():
+            return self.refresh()
+        now, last, self._last_move = loop.time(), self._last_move, loop.time()
+        if now - last > SETTLE_S:                         # a single step: fitted at once
             return self.refresh()
         if self._settle is not None:
             self._settle.cancel()

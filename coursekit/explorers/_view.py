@@ -123,13 +123,9 @@ _CSS = r"""
 
 
 class FigureView(anywidget.AnyWidget):
-    """An ``<img>`` shown at its natural pixel size that reports the screen it is shown on.
-
-    Traits: ``png`` (the image), ``css_width``/``css_height`` (its size in CSS pixels, set by
-    the kernel), ``alt`` (its text alternative) and ``screen`` (set by the browser:
-    ``width``/``height`` of the room for the figure in CSS pixels and the device pixel
-    ``ratio``).
-    """
+    """An ``<img>`` at its natural pixel size: ``png``, ``css_width``/``css_height`` and ``alt``
+    set by the kernel; ``screen`` (``width``/``height`` of the room in CSS pixels, the pixel
+    ``ratio``) set by the browser."""
 
     _esm = _ESM
     _css = _CSS
