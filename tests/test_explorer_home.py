@@ -31,7 +31,7 @@ def home():
 def test_a_callback_from_another_thread_runs_on_the_home_thread(home):
     runner, on_home = home
     ran = []
-    runner.run(lambda x: ran.append((x, threading.current_thread().name)), 1)   # from this thread
+    runner.run(lambda: ran.append((1, threading.current_thread().name)))   # from this thread
     on_home(lambda: None)                     # the loop has run what was queued before
     assert ran == [(1, "home")]
 
@@ -39,14 +39,14 @@ def test_a_callback_from_another_thread_runs_on_the_home_thread(home):
 def test_a_callback_on_the_home_thread_runs_at_once(home):
     runner, on_home = home
     ran = []
-    on_home(lambda: (runner.run(ran.append, "now"), ran.append("after")))
+    on_home(lambda: (runner.run(lambda: ran.append("now")), ran.append("after")))
     assert ran == ["now", "after"]
 
 
 def test_calls_with_a_key_are_queued_once_while_one_waits(home):
     runner, on_home = home
     gate, calls = threading.Event(), []
-    runner.run(gate.wait, 10)                 # the home thread is busy (a cell running)
+    runner.run(lambda: gate.wait(10))         # the home thread is busy (a cell running)
     for _ in range(5):
         runner.run(lambda: calls.append("redraw"), key="refresh")
     runner.run(lambda: calls.append("other"))
@@ -66,7 +66,7 @@ def test_an_error_in_a_queued_callback_is_reported_and_the_next_runs(home, capsy
 
     ran = []
     runner.run(fails)
-    runner.run(ran.append, "next")
+    runner.run(lambda: ran.append("next"))
     on_home(lambda: None)
     assert ran == ["next"]
     assert "ValueError: m: the mass must be positive" in capsys.readouterr().err

@@ -53,8 +53,8 @@ def _range(value, min, max, step, description):
     return value, low, high, step
 
 
-def _style():
-    return dict(style={"description_width": "initial"}, layout={"width": "auto"})
+#: the controls' label above the whole width: the full description, with its unit
+_STYLE = dict(style={"description_width": "initial"}, layout={"width": "auto"})
 
 
 def slider(value: float, min: float, max: float, step: float, description: str, *,
@@ -64,7 +64,7 @@ def slider(value: float, min: float, max: float, step: float, description: str, 
     import ipywidgets as widgets
     value, min, max, step = _range(value, min, max, step, description)
     return widgets.FloatSlider(value=value, min=min, max=max, step=step, description=description,
-                               continuous_update=True, readout_format=readout_format, **_style())
+                               continuous_update=True, readout_format=readout_format, **_STYLE)
 
 
 def int_slider(value: int, min: int, max: int, description: str, *, step: int = 1):
@@ -75,7 +75,7 @@ def int_slider(value: int, min: int, max: int, description: str, *, step: int = 
         raise ValueError(f"value, min, max and step must be whole numbers: received {numbers}.")
     value, min, max, step = (int(x) for x in numbers)
     return widgets.IntSlider(value=value, min=min, max=max, step=step, description=description,
-                             continuous_update=True, **_style())
+                             continuous_update=True, **_STYLE)
 
 
 def dropdown(options, value, description: str):
@@ -87,7 +87,7 @@ def dropdown(options, value, description: str):
     if value not in options:
         raise ValueError(f"value must be one of the options {options}: received {value!r}.")
     _range(0, 0, 1, 1, description)
-    return widgets.Dropdown(options=options, value=value, description=description, **_style())
+    return widgets.Dropdown(options=options, value=value, description=description, **_STYLE)
 
 
 def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, keep: float = 0.5,
@@ -146,12 +146,6 @@ def _fit(ax, name: str, min_span: float, fill: float, keep: float) -> None:
         low = max([low, *(s for s in sticky if low < s <= lo)])
         high = min([high, *(s for s in sticky if hi <= s < high)])
         getattr(ax, f"set_{name}lim")(*scale.inverted().transform([low, high]))
-
-
-def _fit_scale(natural_px, screen: dict, largest: float) -> float:
-    """The factor (at most `largest`) by which a figure of `natural_px` fits the reported room."""
-    room = [float(screen.get(key) or 0) / size for key, size in zip(("width", "height"), natural_px)]
-    return max(min([largest, *(r for r in room if r > 0)]), MIN_SCALE)
 
 
 class Explorer:
@@ -318,12 +312,14 @@ class Explorer:
         self._text.value = self._readout_html(text)
 
     def _on_screen(self, screen: dict) -> None:
-        """Render at the size the figure is shown with: scaled to fit, at the screen's pixel ratio."""
+        """Render at the size the figure is shown with: scaled to fit the reported room (at most
+        its natural size, `LECTURE_MAX_SCALE` in lecture mode), at the screen's pixel ratio."""
         self.screen = dict(screen or {})
         ratio = float(self.screen.get("ratio") or 1.0)
-        natural = self.fig.get_size_inches() * self.natural_dpi
-        largest = LECTURE_MAX_SCALE if self.lecture else 1.0
-        dpi = self.natural_dpi * _fit_scale(natural, self.screen, largest) * ratio
+        room = [float(self.screen.get(key) or 0) / size for key, size in
+                zip(("width", "height"), self.fig.get_size_inches() * self.natural_dpi)]
+        scale = max(min([LECTURE_MAX_SCALE if self.lecture else 1.0, *(r for r in room if r > 0)]), MIN_SCALE)
+        dpi = self.natural_dpi * scale * ratio
         if abs(dpi - self.fig.dpi) > 1e-6:
             self.fig.set_dpi(dpi)
             self.png = self.frames.frame()
@@ -339,18 +335,15 @@ class Explorer:
             width, height = self.frames.canvas.get_width_height(physical=True)
             self._view = FigureView(png=self.png, alt=self.alt, css_width=float(width),
                                     css_height=float(height))
-            self._text = widgets.HTML(self._readout_html(self.text))
-            self._text.add_class("ck-readout-box")
+            self._text = widgets.HTML(self._readout_html(self.text)).add_class("ck-readout-box")
             self._view.observe(lambda change: self._home.run(lambda: self._on_screen(self._view.screen),
                                                              key="screen"), names="screen")
-            header = widgets.HTML(f"<b>{html.escape(self.title)}</b>")
-            header.add_class("ck-title")
+            header = widgets.HTML(f"<b>{html.escape(self.title)}</b>").add_class("ck-title")
             column = "270px" if self.lecture else "300px"
             boxes = widgets.GridBox(list(self.controls.values()), layout=widgets.Layout(
-                grid_template_columns=f"repeat(auto-fill, minmax({column}, 1fr))", width="100%"))
-            boxes.add_class("ck-controls")
-            self._widget = widgets.VBox([header, boxes, self._text, self._view])
-            self._widget.add_class("ck-explorer")
+                grid_template_columns=f"repeat(auto-fill, minmax({column}, 1fr))", width="100%")
+            ).add_class("ck-controls")
+            self._widget = widgets.VBox([header, boxes, self._text, self._view]).add_class("ck-explorer")
             if self.lecture:
                 self._widget.add_class("ck-lecture")
         return self._widget

@@ -44,7 +44,7 @@ class FrameRenderer:
         self.moving: set = set()
         self._animated: list = []
         self._background = None
-        self._key = None
+        self._key = self._layout = None
         self.full_draws = self.blits = 0
 
     def reset(self) -> None:
@@ -52,10 +52,8 @@ class FrameRenderer:
         self._background = None
 
     def frame(self) -> bytes:
-        """Draw the figure as it is now (blitting when only moving artists changed); PNG bytes.
-
-        The artists changed since the last frame (all of them before the first) move from the
-        second frame on."""
+        """The figure as it is now, as PNG bytes (blitted when only moving artists changed). The
+        artists changed since the last frame (all before the first) move from the second on."""
         changed = {a for a in self._children() if a.stale} if self.full_draws else set()
         new = changed - self.moving
         self.moving |= changed
@@ -89,10 +87,9 @@ class FrameRenderer:
         return self._text(), tuple((ax.get_xlim(), ax.get_ylim(), ax.get_position().bounds) for ax in self.fig.axes)
 
     def _animated_now(self) -> list:
-        """Per axes, then for the figure, in drawing order: the moving children, and those drawn
-        after the first moving one that can meet it: inside the axes, where a curve (clipped to it)
-        paints, such as a legend on the data or the frame, not a title or a legend beside it.
-        [] (a plain full draw each frame) when an axes or an axis is among them."""
+        """Per axes and for the figure, in drawing order: the moving children and those drawn after
+        them that can meet them (inside the axes: a legend on the data, not a title); [] (a full
+        draw each frame) when an axes or an axis is among them."""
         from matplotlib.axes import Axes
         from matplotlib.axis import Axis
         renderer, out = self.canvas.get_renderer(), []
@@ -110,13 +107,29 @@ class FrameRenderer:
         self._animated = self._animated_now()
         for artist in self._animated:
             artist.set_animated(True)
-        self.canvas.draw()
+        self._draw_background()
         self._background = self.canvas.copy_from_bbox(self.fig.bbox) if self._animated else None
         self._draw_animated()
         for artist in self._children():      # drawn, or never drawn (an empty title)
             artist.stale = False
         self._key = self._state()
         self.full_draws += 1
+
+    def _draw_background(self) -> None:
+        """Draw the figure without the animated artists. Its layout measures every tick label and
+        title (half a full draw): done again only when that text may measure otherwise (its
+        strings, or the widest tick label's length), not when a step moves only the limits."""
+        widest = [max(map(len, a.get_major_formatter().format_ticks(a.get_major_locator()())), default=0)
+                  for ax in self.fig.axes for a in (ax.xaxis, ax.yaxis)]
+        layout, engine = (self._text(), widest), self.fig.get_layout_engine()
+        if layout != self._layout or engine is None:
+            self._layout = layout
+            return self.canvas.draw()
+        self.fig.set_layout_engine("none")   # the axes stay where the last layout put them
+        try:
+            self.canvas.draw()
+        finally:
+            self.fig.set_layout_engine(engine)
 
     def _draw_animated(self) -> None:
         renderer = self.canvas.get_renderer()

@@ -28,24 +28,19 @@ class HomeThread:
             self.loop = None
         self._queued: set = set()
 
-    def run(self, fn: Callable[..., Any], *args, key: Hashable | None = None) -> None:
-        """Call ``fn(*args)`` on the home thread: now when called there (or when no loop runs
-        there), else queued on its loop. With `key`, a call is not queued while another with the
-        same key waits (it would do the same work: a callback that reads the latest state when it
-        runs, such as a redraw for the sliders' current values)."""
+    def run(self, fn: Callable[[], Any], *, key: Hashable | None = None) -> None:
+        """Call ``fn()`` on the home thread: now when called there (or when no loop runs there),
+        else queued on its loop; with `key`, not while a call with that key waits (it would do
+        the same work: a redraw that reads the sliders' values when it runs)."""
         if threading.current_thread() is self.thread or self.loop is None or self.loop.is_closed():
-            fn(*args)
-            return
-        if key is not None:
-            if key in self._queued:
-                return
+            return fn()
+        if key is None or key not in self._queued:
             self._queued.add(key)
-        self.loop.call_soon_threadsafe(self._call, fn, args, key)
+            self.loop.call_soon_threadsafe(self._call, fn, key)
 
-    def _call(self, fn: Callable[..., Any], args: tuple, key: Hashable | None) -> None:
-        # forgotten before the call: a change that comes while it runs queues the next call
-        self._queued.discard(key)
+    def _call(self, fn: Callable[[], Any], key: Hashable | None) -> None:
+        self._queued.discard(key)   # forgotten first: a change while it runs queues the next call
         try:
-            fn(*args)
+            fn()
         except Exception:   # noqa: BLE001 - as for any widget callback: reported, the kernel goes on
             traceback.print_exc()
