@@ -97,9 +97,9 @@ def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, ke
     The limits change only when they must: when the data leave them, or fill less than
     `keep` of them. They are then set so that the data fill `fill` of the view, so a
     slider moved on in the same direction changes the axes every few steps, not at each
-    (each change of the axes is a full draw of the figure). While a hand moves a control
-    of an `Explorer` the limits only grow, leaving the data `MOVING_FILL` of them; once the
-    control has rested `SETTLE_S` seconds they are fitted as above. They never go past an artist's
+    (each change of the axes is a full draw of the figure). While a hand drags a control of
+    an `Explorer` (moves less than `SETTLE_S` apart) the limits only grow, leaving the data
+    `MOVING_FILL` of them, and are fitted as above once it rests. They never go past an artist's
     sticky edges (matplotlib's ``Artist.sticky_edges``: a time axis that starts at 0 gets
     ``line.sticky_edges.x.append(0)``). `axis` is ``"y"``, ``"x"`` or ``"both"``. With
     `min_span`, the view spans at least that much, centred on the data: a response that stays
