@@ -8,7 +8,7 @@ neither do the slides:
    are not rewritten) and is executed with nbclient, the kernels side by side, without storing
    widget state, so every explorer shows its static figure for the default slider values (the
    slides have no kernel); each figure gets its text alternative from its data, as on the
-   website (`coursekit.tools.site.DESCRIBE_FIGURES`);
+   website (`DESCRIBE_FIGURES`, with the website's `coursekit.tools.site_figures.add_output`);
 2. nbconvert's ``SlidesExporter`` writes the slides with the template ``coursekit_reveal``
    (shipped in this package), which extends nbconvert's reveal template and loads reveal.js and
    MathJax 3 from the folder: no jQuery, require.js or mermaid from a CDN, no MathJax 2 (whose
@@ -36,16 +36,24 @@ import tempfile
 from pathlib import Path
 
 from .builds import start_build
-from .site import ALT, DESCRIBE_FIGURES, WIDGET_VIEW, chapter_entry
+from .site import ALT, WIDGET_VIEW, chapter_entry
 from .slides import with_slide_metadata
 
-__all__ = ["SLIDE_TOOLS", "TEMPLATE", "MATHJAX", "SUFFIX", "build_slides", "missing_slide_tools", "asset_folders",
+__all__ = ["SLIDE_TOOLS", "DESCRIBE_FIGURES", "TEMPLATE", "MATHJAX", "SUFFIX", "build_slides", "missing_slide_tools", "asset_folders",
            "figure_alt_texts", "slides_exporter", "index_page"]
 
 #: import name -> pip name of what the build needs (the ``slides`` extra)
 SLIDE_TOOLS = {"nbconvert": "nbconvert", "nbclient": "nbclient", "nbformat": "nbformat",
                "ipykernel": "ipykernel", "sphinx_revealjs": "sphinx-revealjs",
                "sphinx-mathjax-offline": "sphinx-mathjax-offline"}
+
+#: run first in each notebook the slides execute: every figure gets its description under `ALT`
+#: (the figures themselves are drawn as in JupyterLab: a slide is as wide as the screen)
+DESCRIBE_FIGURES = f"""\
+import coursekit.tools.site_figures as _site_figures
+from coursekit import describe_figure as _describe
+_site_figures.add_output(get_ipython(), {ALT!r}, _describe, explorers=False)
+"""
 
 #: the nbconvert template of the slides, a folder of this package
 TEMPLATE = Path(__file__).resolve().parent / "templates" / "coursekit_reveal"
