@@ -142,7 +142,7 @@ def test_the_axes_fitted_to_the_data_hold_them_and_are_half_filled_at_least(fact
             e.refresh()
             for (ax, name), min_span in fitted.items():
                 scale = getattr(ax, f"{name}axis").get_transform()
-                # the data limits the update measured (relim, or update_datalim for an arrow)
+                # the data limits rescale measured (relim)
                 lo, hi = scale.transform(getattr(ax.dataLim, f"interval{name}"))
                 view = sorted(scale.transform(getattr(ax, f"get_{name}lim")()))
                 assert view[0] <= lo + 1e-9 and hi <= view[1] + 1e-9, (name, value, view, (lo, hi))

@@ -90,8 +90,7 @@ def dropdown(options, value, description: str):
     return widgets.Dropdown(options=options, value=value, description=description, **_STYLE)
 
 
-def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, keep: float = 0.5,
-            relim: bool = True) -> None:
+def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, keep: float = 0.5) -> None:
     """Fit the view of each of `axes` to the data its artists hold (call it in an update).
 
     The limits change only when they must: when the data leave them, or fill less than
@@ -103,9 +102,7 @@ def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, ke
     sticky edges (matplotlib's ``Artist.sticky_edges``: a time axis that starts at 0 gets
     ``line.sticky_edges.x.append(0)``). `axis` is ``"y"``, ``"x"`` or ``"both"``. With
     `min_span`, the view spans at least that much, centred on the data: a response that stays
-    at a constant is drawn flat, not its rounding noise magnified. With ``relim=False`` the
-    data limits are the ones the update set (``ax.update_datalim``), not measured from the
-    artists again (for artists whose extent matplotlib measures poorly, such as arrows).
+    at a constant is drawn flat, not its rounding noise magnified.
     """
     if axis not in ("x", "y", "both"):
         raise ValueError(f"axis must be 'x', 'y' or 'both': received {axis!r}.")
@@ -113,8 +110,7 @@ def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, ke
         raise ValueError(f"fill and keep must satisfy 0 < keep < fill <= 1: received fill={fill!r}, keep={keep!r}.")
     min_span = as_scalar(min_span, "min_span")
     for ax in axes:
-        if relim:
-            ax.relim()
+        ax.relim()
         for name in ("xy" if axis == "both" else axis):
             _fit(ax, name, min_span, fill, keep)
 

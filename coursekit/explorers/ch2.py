@@ -190,7 +190,7 @@ def robot_planner_explorer() -> Explorer:
         ax.plot([0], [0], "ko")
         ax.set_xlabel("x1 [m]")
         ax.set_ylabel("x2 [m]")
-        ax.set_aspect("equal", adjustable="box")
+        ax.set_aspect("equal", adjustable="datalim")
         ax.set_title("path in the plane")
         ax.legend(loc="best", fontsize="small")
         ax.grid(True, alpha=0.4)
@@ -223,7 +223,7 @@ def robot_planner_explorer() -> Explorer:
         tip = _arrow_tip(points, tx, ty, th)
         h["shaft"].set_data(np.linspace(tx, tip[0, 0], 20), np.linspace(ty, tip[0, 1], 20))
         h["ax"].update_datalim(np.vstack([points, tip]))
-        rescale(h["ax"], axis="both", relim=False)
+        h["ax"].autoscale_view()
 
     def readout(r):
         tx, ty, th = r["target"]
