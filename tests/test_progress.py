@@ -21,7 +21,7 @@ import pytest
 import sympy as sp
 
 import coursekit.exercises as ex
-from coursekit.exercises._answers import ANSWERS_ENV, decode, read_records
+from coursekit.exercises._answers import ANSWERS_ENV, decode, read_last_records
 from coursekit.exercises._catalog import CATALOG, STATE
 from coursekit.exercises._progress import CORRECT, NOT_TRIED, NOT_YET
 
@@ -125,14 +125,14 @@ ANSWERS = [
 
 
 def test_recorded_answers_check_again_to_the_same_feedback(tmp_path, monkeypatch):
-    monkeypatch.setenv(ANSWERS_ENV, str(tmp_path / "answers.jsonl"))
-    seen = [_quiet(getattr(ex, name), *args) for name, args in ANSWERS]
-    records = read_records(tmp_path / "answers.jsonl")
-    assert [r["check"] for r in records] == [name for name, _ in ANSWERS]
-    for record, (result, printed) in zip(records, seen):
-        check = getattr(ex, record["check"]).__wrapped__
-        again, printed_again = _quiet(check, *(decode(v) for v in record["args"].values()))
-        assert (bool(again), printed_again) == (bool(result), printed), record["check"]
+    for number, (name, args) in enumerate(ANSWERS):
+        path = tmp_path / f"answers{number}.jsonl"
+        monkeypatch.setenv(ANSWERS_ENV, str(path))
+        result, printed = _quiet(getattr(ex, name), *args)
+        recorded = read_last_records(path)
+        assert list(recorded) == [name]
+        again, printed_again = _quiet(getattr(ex, name).__wrapped__, *(decode(v) for v in recorded[name].values()))
+        assert (bool(again), printed_again) == (bool(result), printed), name
 
 
 def test_nothing_is_recorded_without_the_variable(tmp_path, monkeypatch):
@@ -146,4 +146,4 @@ def test_unreadable_lines_are_skipped(tmp_path):
     path = tmp_path / "answers.jsonl"
     path.write_text('not json\n{"check": 3}\n[1]\n' + "[" * 100_000 + "\n"
                     '{"check": "check_ctrb_matrix", "args": {"Wc": [[1]]}}\n', encoding="utf-8")
-    assert read_records(path) == [{"check": "check_ctrb_matrix", "args": {"Wc": [[1]]}}]
+    assert read_last_records(path) == {"check_ctrb_matrix": {"Wc": [[1]]}}

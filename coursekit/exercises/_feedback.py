@@ -15,14 +15,18 @@ so the feedback reads the same everywhere:
   "Correct" or "Not yet", and returns a `CheckResult`: true exactly when the
   answer is correct, so ``assert ex.check_...(...)`` works, and silent in
   Jupyter (no ``Out[n]:`` line under the feedback it just printed).
+  `feedback_to` sends what `Report` prints to a stream of the caller's in the
+  current thread only (the grader checks several students' answers at once).
 
 Nothing here raises on a wrong answer and nothing prints the expected values.
 """
 
 from __future__ import annotations
 
+import contextlib
+import contextvars
 from dataclasses import dataclass, field
-from typing import Any, Callable, Sequence
+from typing import IO, Any, Callable, Iterator, Sequence
 
 import numpy as np
 
@@ -31,6 +35,7 @@ from .._validation import is_complex
 __all__ = [
     "CheckResult",
     "Report",
+    "feedback_to",
     "close",
     "read_matrix",
     "read_poles",
@@ -41,6 +46,25 @@ __all__ = [
     "call_student_function",
     "rank_decision_feedback",
 ]
+
+#: where `Report.show` prints in this thread or task (None: standard output)
+_STREAM: contextvars.ContextVar[IO[str] | None] = contextvars.ContextVar("coursekit_feedback", default=None)
+
+
+@contextlib.contextmanager
+def feedback_to(stream: IO[str]) -> Iterator[IO[str]]:
+    """Within the block, what the checks print goes to `stream` instead of standard output.
+
+    The redirection holds for the current thread (or asyncio task) only, so
+    threads that check different answers at once keep their feedback apart;
+    ``sys.stdout`` is never touched.
+    """
+    token = _STREAM.set(stream)
+    try:
+        yield stream
+    finally:
+        _STREAM.reset(token)
+
 
 #: relative tolerance for answers worked out by hand (0.333 for 1/3 is accepted)
 RTOL = 1e-3
@@ -93,12 +117,9 @@ class Report:
 
     def show(self, praise: str) -> CheckResult:
         """Print "Correct: praise" or the problems; the result is true when correct."""
-        if self.ok:
-            print(f"Correct: {praise}")
-        else:
-            print(f"Not yet ({self.name}):")
-            for message in self.problems:
-                print(f"  - {message}")
+        lines = ([f"Correct: {praise}"] if self.ok
+                 else [f"Not yet ({self.name}):", *(f"  - {message}" for message in self.problems)])
+        print("\n".join(lines), file=_STREAM.get())
         return CheckResult(self.name, self.ok)
 
 
