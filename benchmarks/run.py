@@ -291,8 +291,9 @@ ABOUT = {
                "Chromium without a GPU spends most of a core on the drag itself (the floor's row: a "
                "slider and a small image), which on 2 cores bounds every row.",
     "grading": "`python -m coursekit grade` on copies of chapter 1's student edition: notebooks graded per "
-               "minute with two at a time against one at a time, and grading one notebook against a plain "
-               "`jupyter nbconvert --execute` of it (both start a fresh kernel).",
+               "minute with two at a time against one at a time, grading one notebook in the bubblewrap "
+               "sandbox against the same without it (`--no-sandbox`), and against a plain "
+               "`jupyter nbconvert --execute` of it (all start a fresh kernel).",
 }
 
 
@@ -325,8 +326,9 @@ def _nbconvert(path: Path, out: Path) -> None:
 
 def bench_grading(repeat: int, count: int = 6) -> list[str]:
     """The grader on copies of chapter 1's student edition: notebooks graded per minute with two
-    at a time against one at a time, and the time to grade one notebook against a plain
-    ``jupyter nbconvert --to notebook --execute`` of it (both start a fresh kernel)."""
+    at a time against one at a time, and the time to grade one notebook in the sandbox against
+    the same without it and against a plain ``jupyter nbconvert --to notebook --execute`` of it
+    (all start a fresh kernel)."""
     import tempfile
     from coursekit.tools.grading import grade
     with tempfile.TemporaryDirectory() as tmp:
@@ -335,6 +337,7 @@ def bench_grading(repeat: int, count: int = 6) -> list[str]:
         med = interleaved({"jobs 1": lambda: grade(many, tmp / "g1", chapter=1, jobs=1),
                            "jobs 2": lambda: grade(many, tmp / "g2", chapter=1, jobs=2),
                            "grade one": lambda: grade(one, tmp / "g", chapter=1, jobs=1),
+                           "no sandbox": lambda: grade(one, tmp / "u", chapter=1, jobs=1, sandbox=False),
                            "nbconvert": lambda: _nbconvert(one / "s01.ipynb", tmp / "nbconvert")}, repeat)
     per_minute = {jobs: 60 * count / med[jobs] for jobs in ("jobs 1", "jobs 2")}
     load = os.getloadavg()[1] if hasattr(os, "getloadavg") else float("nan")
@@ -343,7 +346,9 @@ def bench_grading(repeat: int, count: int = 6) -> list[str]:
             f"| notebooks graded per minute, --jobs 1 ({count} notebooks) | {per_minute['jobs 1']:.1f} | |",
             f"| notebooks graded per minute, --jobs 2 | {per_minute['jobs 2']:.1f} | |",
             f"| speed-up --jobs 2 / --jobs 1 | {per_minute['jobs 2'] / per_minute['jobs 1']:.2f} | >= 1.6 |",
-            f"| grading one notebook | {med['grade one']:.1f} s | |",
+            f"| grading one notebook (sandboxed) | {med['grade one']:.1f} s | |",
+            f"| the same with --no-sandbox | {med['no sandbox']:.1f} s | |",
+            f"| sandboxed / not sandboxed | {med['grade one'] / med['no sandbox']:.2f} | <= 1.15 |",
             f"| jupyter nbconvert --execute of it | {med['nbconvert']:.1f} s | |",
             f"| grader / nbconvert | {med['grade one'] / med['nbconvert']:.2f} | <= 1.3 |"]
 

@@ -167,32 +167,32 @@ def _run_site(args) -> int:
     return 0
 
 
-_NOT_A_SANDBOX = (
-    "This is not a sandbox: a notebook runs with your rights and can read (and change) every file you "
-    "can. For untrusted notebooks, or many of them, run the grader in a container with only the "
-    "submissions and the output folder mounted, e.g. docker run --rm --network none -v "
-    "\"$PWD/submissions:/submissions:ro\" -v \"$PWD/grades:/grades\" IMAGE python -m coursekit grade "
-    "--chapter 1 /submissions --out /grades (IMAGE: any image with coursekit[grade] installed; "
-    "podman takes the same arguments). See docs/grading.md.")
+_SANDBOX = (
+    "Each notebook's kernel runs sealed off with bubblewrap (bwrap; Debian/Ubuntu: apt-get install "
+    "bubblewrap): the filesystem read-only and reduced to what Python needs, one private writable folder, "
+    "no network, no other process visible, nothing left running after it. Where bwrap cannot run (not "
+    "Linux, not installed, user namespaces refused) the grader stops and says so; --no-sandbox then runs "
+    "the notebooks with your rights, or run the grader in a container (docker or podman run --rm "
+    "--network none ...). See docs/grading.md.")
 
 
 def _add_grade(commands) -> None:
     parser = commands.add_parser(
         "grade", help="grade a folder of submitted notebooks (grades.csv and feedback per student)",
         description="Execute each submitted notebook of SUBMISSIONS (file name stem = student id) top to "
-                    "bottom in a fresh kernel of its own, in a temporary folder holding only a copy of it, "
-                    "with a time and a memory limit; record the answers its check_* calls receive and "
+                    "bottom in a fresh kernel of its own, sealed off in a sandbox, "
+                    "with time, memory and file-size limits; record the answers its check_* calls receive and "
                     "check the last answer to each exercise again with the course's own checks, outside "
                     "the notebook (a check replaced or patched in the notebook awards nothing). Writes "
                     "DIR/grades.csv (one row per student: 1 or 0 per exercise, total, status) and "
                     "DIR/feedback/STUDENT.md (what each check says about the answer, never the solution). "
                     "Needs the grade extra: python -m pip install -e \".[grade]\". "
                     "Statuses: " + "; ".join(f"{k}: {v}" for k, v in _statuses().items()) + ". "
-                    + _NOT_A_SANDBOX)
+                    + _SANDBOX)
     parser.add_argument("submissions", type=Path, metavar="SUBMISSIONS",
                         help="folder of the submitted notebooks (*.ipynb), one per student")
     parser.add_argument("--chapter", required=True, type=int, metavar="N",
-                        help="the chapter the notebooks are (1, 2, 3 or 4)")
+                        help="the chapter the notebooks are (one of the chapters with exercises)")
     parser.add_argument("--out", required=True, type=Path, metavar="DIR",
                         help="folder for grades.csv and feedback/ (created when missing; an earlier "
                              "grades.csv and feedback/*.md there are replaced)")
@@ -202,6 +202,10 @@ def _add_grade(commands) -> None:
                         help="address-space limit of each notebook's kernel, e.g. 4G or 512M (default: 4G)")
     parser.add_argument("--jobs", type=int, default=None, metavar="N",
                         help="notebooks run at once (default: the number of cores)")
+    parser.add_argument("--no-sandbox", dest="sandbox", action="store_false",
+                        help="run the notebooks WITHOUT the bubblewrap sandbox, with your own rights: they "
+                             "can read, change or delete your files and use the network (only for "
+                             "notebooks you trust, or inside a container)")
     parser.set_defaults(run=_run_grade)
 
 
@@ -213,7 +217,7 @@ def _statuses() -> dict:
 def _run_grade(args) -> int:
     from .tools.grading import grade
     table = grade(args.submissions, args.out, chapter=args.chapter, timeout=args.timeout,
-                  memory=args.memory, jobs=args.jobs)
+                  memory=args.memory, jobs=args.jobs, sandbox=args.sandbox)
     print(f"grades written to {table}, feedback to {table.parent / 'feedback'}")
     return 0
 

@@ -1,22 +1,30 @@
 """Execute one submitted notebook for the grader, in a process of its own.
 
-``python -m coursekit.tools._notebook_run NOTEBOOK KERNELS_DIR TIMEOUT MEMORY_BYTES``
-runs every cell of NOTEBOOK top to bottom in a fresh kernel (nbclient) whose
-working folder is the notebook's folder, started from a kernel spec written to
-KERNELS_DIR that applies the memory limit (`coursekit.tools._limited_kernel`). A
-cell that raises does not stop the run (the later exercises still count).
-TIMEOUT (seconds) bounds the whole notebook, not each cell.
+``python -m coursekit.tools._notebook_run JOB`` reads the job (JSON written by
+the grader: ``notebook``, ``kernel_argv``, ``timeout``, ``memory``,
+``connection_file``) and runs every cell of the notebook top to bottom in a
+fresh kernel (nbclient) started with ``kernel_argv`` (the grader's limited
+kernel, `coursekit.tools._limited_kernel`, inside its sandbox,
+`coursekit.tools.sandbox`). When ``connection_file`` is set, the kernel talks
+to this runner through Unix sockets next to that file (the sandboxed kernel
+has no network). The saved outputs are cleared first: only this run counts.
+A cell that raises does not stop the run (the later exercises still count).
+The time limit bounds the whole notebook, not each cell. A kernel that fails
+to start is started once more before the notebook counts as crashed.
 
-The last line printed on stdout is the outcome as JSON, ``{"status": ...,
-"detail": ...}``, with status ``ok``, ``cell error``, ``memory`` (a cell ran
-out of memory), ``timeout`` or ``crashed`` (the kernel died or did not
-start). The kernel's own output goes nowhere, so it cannot print an outcome.
-The answers themselves reach the grader through the file the environment
-variable ``COURSEKIT_ANSWERS_FILE`` names (see `coursekit.exercises._answers`).
+This runner stays outside the sandbox: the kernel can neither see nor signal
+it, nor write to its output. The last line it prints on stdout is the outcome
+as JSON, ``{"status": ..., "detail": ..., "errors": [...]}``, with status ``ok``,
+``cell error``, ``memory`` (a cell ran out of memory), ``timeout`` or
+``crashed`` (the kernel died or did not start); ``errors`` lists the cells
+that raised, numbered from 1 as they stand in the notebook. The answers
+themselves reach the grader through the file the environment variable
+``COURSEKIT_ANSWERS_FILE`` names inside the kernel (`coursekit.exercises._answers`).
 """
 
 from __future__ import annotations
 
+import contextlib
 import json
 import math
 import subprocess
@@ -24,9 +32,10 @@ import sys
 import time
 from pathlib import Path
 
-from ._limited_kernel import kernel_argv, set_limits
+from ._limited_kernel import set_limits
 
-__all__ = ["KERNEL_NAME", "RUNNER_MEMORY", "write_kernel_spec", "execute", "main"]
+__all__ = ["KERNEL_NAME", "RUNNER_MEMORY", "STARTS", "RUNNER_STATUSES", "write_kernel_spec", "execute",
+           "main"]
 
 #: name of the kernel spec the grader writes for its kernels
 KERNEL_NAME = "coursekit-grade"
@@ -35,34 +44,53 @@ KERNEL_NAME = "coursekit-grade"
 #: end fills the runner's copy of the outputs: the runner then fails, not the machine)
 RUNNER_MEMORY = 2 * 2**30
 
+#: how many times a kernel is started before the notebook counts as crashed
+STARTS = 2
 
-def write_kernel_spec(kernels_dir: Path, memory_bytes: int, cpu_seconds: int) -> Path:
-    """Write the grader's kernel spec into `kernels_dir`; returns its folder."""
+#: the statuses this runner reports (the grader accepts no other)
+RUNNER_STATUSES = ("ok", "cell error", "memory", "timeout", "crashed")
+
+
+def write_kernel_spec(kernels_dir: Path, argv: list[str]) -> Path:
+    """Write the grader's kernel spec, which starts kernels with `argv`, into `kernels_dir`."""
     folder = Path(kernels_dir) / KERNEL_NAME
     folder.mkdir(parents=True, exist_ok=True)
-    spec = {"argv": kernel_argv(memory_bytes, cpu_seconds), "display_name": "coursekit grader",
-            "language": "python", "metadata": {"debugger": False}}
+    spec = {"argv": list(argv), "display_name": "coursekit grader", "language": "python",
+            "metadata": {"debugger": False}}
     (folder / "kernel.json").write_text(json.dumps(spec), encoding="utf-8")
     return folder
 
 
-def _cell_errors(nb) -> list[tuple[int, str]]:
-    """(index, exception name) of the cells whose outputs show an error."""
-    return [(index, output.get("ename", "Error")) for index, cell in enumerate(nb.cells)
-            if cell.cell_type == "code" for output in cell.get("outputs", [])
-            if output.get("output_type") == "error"]
+def _text(value, limit: int = 200) -> str:
+    """A kernel-supplied string, cut to `limit` characters on one line."""
+    return " ".join(str(value).split())[:limit]
+
+
+def _cell_errors(nb) -> list[dict]:
+    """The cells whose outputs show an error: their number from 1, the exception's name and message."""
+    return [{"cell": index + 1, "ename": _text(output.get("ename", "Error"), 80),
+             "evalue": _text(output.get("evalue", ""))}
+            for index, cell in enumerate(nb.cells) if cell.cell_type == "code"
+            for output in cell.get("outputs", []) if output.get("output_type") == "error"]
 
 
 def _outcome_of_errors(nb) -> dict:
     errors = _cell_errors(nb)
-    cells = [str(i) for i, name in errors if name == "MemoryError"]
+    cells = [str(e["cell"]) for e in errors if e["ename"] == "MemoryError"]
     if cells:
         which = f"cell {cells[0]}" if len(cells) == 1 else f"cells {', '.join(cells)}"
-        return {"status": "memory", "detail": f"{which} ran out of memory (MemoryError)"}
+        return {"status": "memory", "detail": f"{which} ran out of memory (MemoryError)", "errors": errors}
     if errors:
-        listed = ", ".join(f"cell {i} ({name})" for i, name in errors)
-        return {"status": "cell error", "detail": f"cells raised an exception: {listed}"}
-    return {"status": "ok", "detail": "the notebook ran to the end"}
+        listed = ", ".join(f"cell {e['cell']} ({e['ename']})" for e in errors)
+        return {"status": "cell error", "detail": f"cells raised an exception: {listed}", "errors": errors}
+    return {"status": "ok", "detail": "the notebook ran to the end", "errors": []}
+
+
+def _clear_outputs(nb) -> None:
+    """Forget the outputs saved with the notebook: a cell this run does not execute shows none."""
+    for cell in nb.cells:
+        if cell.cell_type == "code":
+            cell.outputs, cell.execution_count = [], None
 
 
 def _run_cells(client, nb, deadline: float) -> None:
@@ -75,39 +103,66 @@ def _run_cells(client, nb, deadline: float) -> None:
         client.execute_cell(cell, index)
 
 
-def execute(notebook: Path, kernels_dir: Path, timeout: float, memory_bytes: int) -> dict:
-    """Run `notebook` (read with nbformat) and return its outcome (see the module docstring)."""
-    import nbformat
+def _client(nb, job: dict, kernels_dir: Path):
     from jupyter_client.kernelspec import KernelSpecManager
     from jupyter_client.manager import AsyncKernelManager
     from nbclient import NotebookClient
+    write_kernel_spec(kernels_dir, job["kernel_argv"])
+    options = {}
+    if job.get("connection_file"):
+        connection = Path(job["connection_file"])
+        options = {"transport": "ipc", "ip": str(connection.with_name("ipc")), "connection_file": str(connection)}
+    km = AsyncKernelManager(kernel_name=KERNEL_NAME, kernel_spec_manager=KernelSpecManager(
+        kernel_dirs=[str(kernels_dir)]), **options)
+    return NotebookClient(nb, km=km, allow_errors=True, startup_timeout=120,
+                          resources={"metadata": {"path": str(Path(job["notebook"]).parent)}})
+
+
+def _started(nb, job: dict, kernels_dir: Path, deadline: float):
+    """A client whose kernel has started, and the stack that shuts it down; a kernel that fails
+    to start is started again (`STARTS` times in all) while time is left."""
+    starts = 0
+    while True:
+        starts += 1
+        client, stack = _client(nb, job, kernels_dir), contextlib.ExitStack()
+        try:
+            stack.enter_context(client.setup_kernel(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
+            return client, stack
+        except RuntimeError:
+            stack.close()
+            if starts == STARTS or time.monotonic() >= deadline:
+                raise
+
+
+def execute(job: dict, kernels_dir: Path) -> dict:
+    """Run the job's notebook (read with nbformat) and return its outcome (see the module docstring)."""
+    import nbformat
     from nbclient.exceptions import CellTimeoutError, DeadKernelError
 
-    nb = nbformat.read(notebook, as_version=4)
-    write_kernel_spec(kernels_dir, memory_bytes, cpu_seconds=math.ceil(timeout) + 30)
-    km = AsyncKernelManager(kernel_name=KERNEL_NAME,
-                            kernel_spec_manager=KernelSpecManager(kernel_dirs=[str(kernels_dir)]))
-    client = NotebookClient(nb, km=km, allow_errors=True, startup_timeout=120,
-                            resources={"metadata": {"path": str(notebook.parent)}})
+    timeout = float(job["timeout"])
+    nb = nbformat.read(job["notebook"], as_version=4)
+    _clear_outputs(nb)
     deadline = time.monotonic() + timeout
     try:
-        with client.setup_kernel(stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL):
+        client, kernel = _started(nb, job, kernels_dir, deadline)
+        with kernel:
             _run_cells(client, nb, deadline)
     except (CellTimeoutError, TimeoutError):
-        return {"status": "timeout", "detail": f"stopped at the time limit of {timeout:g} s"}
+        return {"status": "timeout", "detail": f"stopped at the time limit of {timeout:g} s", "errors": []}
     except DeadKernelError:
         return {"status": "crashed", "detail": "the kernel died while a cell ran (os._exit, a crash "
-                                               "in compiled code, or the memory limit)"}
+                                               "in compiled code, or the memory limit)", "errors": []}
     except RuntimeError as error:
-        return {"status": "crashed", "detail": f"the kernel did not start: {error}"}
+        return {"status": "crashed", "detail": f"the kernel did not start: {_text(error)}", "errors": []}
     return _outcome_of_errors(nb)
 
 
 def main(argv: list[str]) -> int:
-    """Command-line entry: print the outcome of running the notebook as the last line."""
-    notebook, kernels_dir, timeout, memory_bytes = Path(argv[0]), Path(argv[1]), float(argv[2]), int(argv[3])
-    set_limits(memory_bytes + RUNNER_MEMORY)
-    outcome = execute(notebook, kernels_dir, timeout, memory_bytes)
+    """Command-line entry: print the outcome of running the job's notebook as the last line."""
+    job_file = Path(argv[0])
+    job = json.loads(job_file.read_text(encoding="utf-8"))
+    set_limits(int(job["memory"]) + RUNNER_MEMORY)
+    outcome = execute(job, job_file.parent / "kernels")
     sys.stdout.write("\n" + json.dumps(outcome) + "\n")
     sys.stdout.flush()
     return 0
