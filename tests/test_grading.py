@@ -206,7 +206,7 @@ def test_missing_tools_name_the_extra_to_install(tmp_path, monkeypatch):
 
 def test_a_kernel_that_fails_to_start_once_is_started_again(monkeypatch, tmp_path):
     """A kernel start that fails once (a busy machine) must not cost an honest student the chapter."""
-    from coursekit.tools import _notebook_run as runner
+    from coursekit.tools.grading import runner
     starts = []
 
     class Client:
@@ -232,7 +232,7 @@ def test_a_kernel_that_fails_to_start_once_is_started_again(monkeypatch, tmp_pat
                                      '{"status": "ok"}', '["ok"]', '{"status": "grader error", "detail": "", '
                                      '"errors": []}'])
 def test_only_the_runners_own_outcomes_are_accepted(printed):
-    from coursekit.tools.grading import _runner_outcome
+    from coursekit.tools.grading.grader import _runner_outcome
     assert _runner_outcome(f"noise\n{printed}\n", 0)["status"] == "crashed"
     good = _runner_outcome('{"status": "cell error", "detail": "d", "errors": [{"cell": 2, "ename": "E", '
                            '"evalue": "m"}, {"cell": "x"}]}', 0)

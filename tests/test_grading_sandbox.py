@@ -27,10 +27,10 @@ from nbformat.v4 import new_code_cell, new_notebook, new_output
 
 from coursekit.__main__ import main
 from coursekit.exercises._catalog import chapter_exercises
-from coursekit.tools import sandbox as sandbox_module
+from coursekit.tools.grading import sandbox as sandbox_module
 from coursekit.tools.grading import SandboxUnavailable, grade
 from coursekit.tools.release import default_notebook_dir, read_notebook
-from coursekit.tools.sandbox import find_bwrap
+from coursekit.tools.grading.sandbox import find_bwrap
 from grading_cases import answer, solved
 
 CHECKS = [entry.check for entry in chapter_exercises(1)]

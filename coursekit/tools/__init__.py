@@ -4,8 +4,8 @@
   roles of a notebook's cells that the other tools read; `builds` holds what the builds share;
 * `release` writes the student edition, `slides` the slide metadata, `colab` the install cell;
 * `site` builds the course website (`site_figures` draws its figures for the page), `slideshow`
-  the slides of every chapter, `grading` grades submitted notebooks, each run by `_notebook_run`
-  in a kernel with `_limited_kernel`'s limits, sealed off by `sandbox`.
+  the slides of every chapter, `grading` (a package: grader, runner, kernel, sandbox) grades
+  submitted notebooks, each sealed off.
 
 ``python -m coursekit --help`` lists the commands that call them.
 """

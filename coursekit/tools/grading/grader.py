@@ -1,13 +1,13 @@
-"""Grade a folder of submitted notebooks: ``python -m coursekit grade --chapter N SUBMISSIONS --out DIR``.
+"""The grader: ``python -m coursekit grade --chapter N SUBMISSIONS --out DIR``.
 
 `grade` executes every ``*.ipynb`` of SUBMISSIONS (regular files only: links
 and special files are skipped; the file name's stem is the student's id),
 each in a fresh kernel of its own, sealed off by the sandbox of
-`coursekit.tools.sandbox` (bubblewrap: read-only system, no network, no other
+`coursekit.tools.grading.sandbox` (bubblewrap: read-only system, no network, no other
 process, nothing of the instructor's files, the other submissions or the
 grader's folders), with a time limit for the whole notebook and memory,
 CPU-time and file-size limits for its kernel, `jobs` at a time
-(`coursekit.tools._notebook_run`, which runs outside the sandbox). While a
+(`coursekit.tools.grading.runner`, which runs outside the sandbox). While a
 notebook runs, each call of a course ``check_*`` appends the answer to a
 file in the submission's one writable folder; the grader reads it back
 afterwards as data only, bounded (`coursekit.exercises._answers`). It then
@@ -46,11 +46,11 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from ..exercises._answers import ANSWERS_ENV, decode, read_last_records
-from ..exercises._catalog import CATALOG, chapter_exercises
-from ..exercises._feedback import feedback_to
-from ._limited_kernel import kernel_argv
-from ._notebook_run import RUNNER_STATUSES
+from ...exercises._answers import ANSWERS_ENV, decode, read_last_records
+from ...exercises._catalog import CATALOG, chapter_exercises
+from ...exercises._feedback import feedback_to
+from .kernel import kernel_argv
+from .runner import RUNNER_STATUSES
 from .sandbox import Sandbox, SandboxUnavailable, check_sandbox
 
 __all__ = ["STATUSES", "Outcome", "grade", "parse_memory", "grade_answers", "student_id", "SandboxUnavailable"]
@@ -163,7 +163,9 @@ def _kernel_env(answers: Path) -> dict:
 
 
 def _package_root() -> Path:
-    return Path(__file__).resolve().parents[2]
+    """The folder that holds the ``coursekit`` package the grader runs (the kernels import it too)."""
+    import coursekit
+    return Path(coursekit.__file__).resolve().parents[1]
 
 
 def _stop(process: subprocess.Popen) -> None:
@@ -197,8 +199,8 @@ class _Run:
         return self.sandbox(box, answers).command(argv) if self.sandboxed else argv
 
 
-def _run_notebook(nb, number: int, run: _Run) -> tuple[str, str, list[dict], dict[str, dict]]:
-    """Execute `nb` in a sandbox of its own; (status, detail, cell errors, last answer per check)."""
+def _run_notebook(nb, number: int, run: _Run, checks: list[str]) -> tuple[str, str, list[dict], dict[str, dict]]:
+    """Execute `nb` in a sandbox of its own; (status, detail, cell errors, last answer to each of `checks`)."""
     import nbformat
     own = run.folder / str(number)
     box, private = own / "box", own / "runner"       # the kernel's only writable folder; the runner's
@@ -216,7 +218,6 @@ def _run_notebook(nb, number: int, run: _Run) -> tuple[str, str, list[dict], dic
     env = {**os.environ, **({} if run.sandboxed else _kernel_env(answers))}
     with open(answers, encoding="utf-8", errors="replace") as held:  # still readable if the notebook deletes it
         outcome = _execute(private / "job.json", job, env)
-        checks = [entry.check for entry in chapter_exercises(run.chapter)]
         last = read_last_records(held, checks)
     return outcome["status"], outcome["detail"], outcome["errors"], last
 
@@ -224,7 +225,7 @@ def _run_notebook(nb, number: int, run: _Run) -> tuple[str, str, list[dict], dic
 def _execute(job_file: Path, job: dict, env: dict) -> dict:
     """Run the notebook's runner; its outcome, accepted only in the runner's own form."""
     job_file.write_text(json.dumps(job), encoding="utf-8")
-    command = [sys.executable, "-m", "coursekit.tools._notebook_run", str(job_file)]
+    command = [sys.executable, "-m", "coursekit.tools.grading.runner", str(job_file)]
     env["PYTHONPATH"] = os.pathsep.join(p for p in (str(_package_root()), env.get("PYTHONPATH")) if p)
     process = subprocess.Popen(command, cwd=job_file.parent, env=env, stdout=subprocess.PIPE,
                                stderr=subprocess.DEVNULL, stdin=subprocess.DEVNULL, text=True,
@@ -277,7 +278,7 @@ NOT_ANSWERED = ("Not answered: no answer to this exercise reached the course's c
 def grade_answers(last: dict[str, dict], exercises) -> tuple[dict[str, int], dict[str, str]]:
     """Scores and feedback per exercise of `exercises` from the last answer recorded for each
     check (``{check: arguments}``, as `read_last_records` gives)."""
-    from .. import exercises as course
+    from ... import exercises as course
     scores, feedback = {}, {}
     for entry in exercises:
         if entry.check not in last:
@@ -320,7 +321,7 @@ def _grade_one(path: Path, number: int, run: _Run) -> Outcome:
         if isinstance(read, tuple):
             (status, detail), last = read, {}
         else:
-            status, detail, errors, last = _run_notebook(read, number, run)
+            status, detail, errors, last = _run_notebook(read, number, run, [e.check for e in exercises])
             detail = "\n".join([detail, *_error_lines(read, errors, exercises)])
         scores, feedback = grade_answers(last, exercises)
     except Exception as error:  # the grade book is written whatever happens to one notebook

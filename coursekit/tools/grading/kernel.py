@@ -1,6 +1,6 @@
 """Start an IPython kernel with memory, CPU-time and file-size limits (for the grader's kernels).
 
-``python -m coursekit.tools._limited_kernel MEMORY_BYTES CPU_SECONDS -f CONNECTION_FILE ...``
+``python -m coursekit.tools.grading.kernel MEMORY_BYTES CPU_SECONDS -f CONNECTION_FILE ...``
 sets the kernel process's limits with `resource.setrlimit` (soft and hard, so
 the notebook cannot raise them again) and then replaces itself with the usual
 ``python -m ipykernel_launcher ...``, which keeps them:
@@ -33,7 +33,7 @@ FILE_BYTES = 256 * 2**20
 
 def kernel_argv(memory_bytes: int, cpu_seconds: int) -> list[str]:
     """The ``argv`` of a kernel spec whose kernels start with these limits."""
-    return [sys.executable, "-m", "coursekit.tools._limited_kernel", str(int(memory_bytes)), str(int(cpu_seconds)),
+    return [sys.executable, "-m", "coursekit.tools.grading.kernel", str(int(memory_bytes)), str(int(cpu_seconds)),
             "-f", "{connection_file}", "--HistoryManager.hist_file=:memory:"]
 
 

@@ -1,11 +1,11 @@
 """Execute one submitted notebook for the grader, in a process of its own.
 
-``python -m coursekit.tools._notebook_run JOB`` reads the job (JSON written by
+``python -m coursekit.tools.grading.runner JOB`` reads the job (JSON written by
 the grader: ``notebook``, ``kernel_argv``, ``timeout``, ``memory``,
 ``connection_file``) and runs every cell of the notebook top to bottom in a
 fresh kernel (nbclient) started with ``kernel_argv`` (the grader's limited
-kernel, `coursekit.tools._limited_kernel`, inside its sandbox,
-`coursekit.tools.sandbox`). When ``connection_file`` is set, the kernel talks
+kernel, `coursekit.tools.grading.kernel`, inside its sandbox,
+`coursekit.tools.grading.sandbox`). When ``connection_file`` is set, the kernel talks
 to this runner through Unix sockets next to that file (the sandboxed kernel
 has no network). The saved outputs are cleared first: only this run counts.
 A cell that raises does not stop the run (the later exercises still count).
@@ -32,7 +32,7 @@ import sys
 import time
 from pathlib import Path
 
-from ._limited_kernel import set_limits
+from .kernel import set_limits
 
 __all__ = ["KERNEL_NAME", "RUNNER_MEMORY", "STARTS", "RUNNER_STATUSES", "write_kernel_spec", "execute",
            "main"]
