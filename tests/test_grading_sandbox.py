@@ -17,6 +17,7 @@ import hashlib
 import json
 import os
 import socket
+import sys
 import threading
 import uuid
 from pathlib import Path
@@ -242,3 +243,19 @@ def test_without_bwrap_the_grader_refuses_in_one_line(tmp_path, monkeypatch, cap
     assert not (tmp_path / "out").exists()
     table = grade(tmp_path / "subs", tmp_path / "out", chapter=1, sandbox=False)
     assert table.exists()
+
+
+def test_the_sandbox_never_shows_the_home_or_working_folder(tmp_path, monkeypatch):
+    """Folders on sys.path are shown read-only, but never the home or the working folder
+    (``python -m`` puts the latter on sys.path), and a hidden folder inside a shown one is covered."""
+    from coursekit.tools.grading.sandbox import Sandbox
+    monkeypatch.chdir(tmp_path)
+    for entry in (str(Path.home()), str(tmp_path), "/"):
+        monkeypatch.syspath_prepend(entry)
+    inside = Path(sys.prefix).resolve() / "hidden-inside-python"
+    args = Sandbox(box=tmp_path / "box", package_root=Path("/nowhere"), hidden=(inside,)).command(["true"])
+    shown = {args[i + 1] for i, flag in enumerate(args) if flag in ("--ro-bind", "--bind", "--ro-bind-try")}
+    assert str(Path.home().resolve()) not in shown and str(tmp_path.resolve()) not in shown and "/" not in shown
+    assert str(Path(sys.prefix).resolve()) in shown and str((tmp_path / "box").resolve()) in shown
+    assert args[args.index(str(inside)) - 1] == "--tmpfs"
+    assert "--unshare-all" in args and "--die-with-parent" in args and "--clearenv" in args

@@ -72,17 +72,18 @@ def _inside(path: Path, folders) -> bool:
 
 
 def _python_folders(package_root: Path) -> list[Path]:
-    """The folders a kernel reads Python and its packages from (the working folder excepted:
-    ``python -m`` puts it on ``sys.path``, and it may be the instructor's home)."""
+    """The folders a kernel reads Python and its packages from. Never the working folder
+    (``python -m`` puts it on ``sys.path``), the home folder or one of their parents: a
+    ``sys.path`` entry such as these would show the instructor's files whole."""
     candidates = {sys.prefix, sys.base_prefix, sys.exec_prefix, sys.base_exec_prefix,
                   sysconfig.get_paths()["stdlib"], sysconfig.get_paths()["purelib"],
                   sysconfig.get_paths()["platlib"], os.path.dirname(os.path.realpath(sys.executable))}
     candidates.update(entry for entry in sys.path if entry and os.path.isabs(entry))
-    cwd = Path.cwd().resolve()
+    private = [Path.cwd().resolve(), Path.home().resolve()]
     folders = set()
     for entry in candidates:
         path = Path(entry).resolve()
-        if path.is_dir() and path != cwd and path != Path("/") and path not in cwd.parents:
+        if path.is_dir() and not any(path == folder or path in folder.parents for folder in private):
             folders.add(path)
     folders.add(package_root / "coursekit")
     return sorted(f for f in folders if not _inside(f.parent, folders) and not _inside(f, _system_roots()))
