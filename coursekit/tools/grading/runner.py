@@ -12,8 +12,8 @@ A cell that raises does not stop the run (the later exercises still count).
 The time limit bounds the whole notebook, not each cell. A kernel that fails
 to start is started once more before the notebook counts as crashed.
 
-This runner stays outside the sandbox: the kernel can neither see nor signal
-it, nor write to its output. The last line it prints on stdout is the outcome
+This runner stays outside the sandbox: a sandboxed kernel can neither see nor
+signal it, nor write to its output. The last line it prints on stdout is the outcome
 as JSON, ``{"status": ..., "detail": ..., "errors": [...]}``, with status ``ok``,
 ``cell error``, ``memory`` (a cell ran out of memory), ``timeout`` or
 ``crashed`` (the kernel died or did not start); ``errors`` lists the cells
