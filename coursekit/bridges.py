@@ -38,6 +38,8 @@ import re
 
 import numpy as np
 
+__all__ = ["realization_hint", "from_control", "to_control", "from_scipy", "to_scipy"]
+
 # The bridges are used through StateSpace's methods; nothing here is a top-level name.
 __all__: list[str] = []
 
