@@ -915,6 +915,12 @@ warns("place", "A scaled by 1e200", lambda: ck.place(A2 * 1e200, B2, P2), "poles
 
 
 # ---------------------------------------------------------------------------
+# issue 35: the tail after issue 25 (one hang, raw errors, NaN/inf answers, quiet misses)
+
+bad("simulate", "Van der Pol stiff on the way, DOP853", lambda: ck.simulate(_vdp(1e4), np.linspace(0, 100, 11), x0=[1.0, 0.0],
+                                                                           method="DOP853"), "method", also="stiff(?s:.*)Radau")
+
+# ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"
 
 #: every check of the course (a new chapter's too) and the number of answers it takes
