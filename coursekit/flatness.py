@@ -496,7 +496,10 @@ def _slowest_point(plan: FlatPlan):
     P = np.polynomial.Polynomial
     # F_j as polynomials in the centred time s = 2 t / T - 1; F_j' in s is proportional to F_j' in t
     vel = [P(traj.coeffs).deriv() for traj in plan.trajectories]
-    speed_sq = sum(v * v for v in vel)
+    # one common scale (the roots do not change): F' ~ |F(T) - F(0)| or v T, whose square
+    # overflows for a horizon such as T = 1e300
+    scale = max(float(np.abs(v.coef).max()) for v in vel) or 1.0
+    speed_sq = sum((v / scale) * (v / scale) for v in vel)
     roots = speed_sq.deriv().roots()
     s = np.concatenate([[-1.0, 1.0], roots.real[(np.abs(roots.imag) < 1e-9) & (np.abs(roots.real) <= 1)]])
     k = int(np.argmin(speed_sq(s)))

@@ -273,6 +273,28 @@ def _check_boundaries(traj: PolyTrajectory) -> None:
     )
 
 
+def _check_finite(traj: PolyTrajectory) -> None:
+    """Raise naming T when a derivative of traj is inf or NaN somewhere on [0, T].
+
+    The k-th derivative scales like 1/T^k and the conditions in normalized time like
+    y^(k) T^k: for a T far from 1 (1e-300, 1e300) they leave the float range, and a plan
+    built on such a trajectory would hand out inf or NaN without a word.
+    """
+    t = traj.T * np.linspace(0.0, 1.0, _CENTRES + 1)
+    with np.errstate(all="ignore"):
+        for k in range(traj.degree + 1):
+            values = traj._eval(t, k)
+            if not np.isfinite(values).all():
+                bad = values[~np.isfinite(values)][0]
+                raise ValueError(
+                    f"T = {traj.T:g} is out of reach of double precision for this trajectory: its "
+                    f"derivative y^({k}) on [0, T] is {bad} (the k-th derivative scales like 1/T^k, "
+                    f"the boundary conditions in normalized time like y^(k) T^k, k up to "
+                    f"{traj.degree}). Express time in other units so that T is nearer 1 (ms, "
+                    "minutes, hours), or use fewer boundary conditions."
+                )
+
+
 def poly_trajectory(T, start, end) -> PolyTrajectory:
     """Polynomial trajectory from `start` at t = 0 to `end` at t = T.
 
@@ -289,7 +311,9 @@ def poly_trajectory(T, start, end) -> PolyTrajectory:
     Guarantees, for r up to 20 and any T whose powers T^k (k < 2r) stay in
     double range: each boundary value and derivative is met to a few units in
     the last place of its own value, and every derivative on [0, T] is within
-    about 50 eps of that derivative's largest value there. After building,
+    about 50 eps of that derivative's largest value there. A T for which a
+    derivative on [0, T] leaves the float range (inf or NaN) raises a
+    ValueError naming T. After building,
     the 2r boundary conditions are evaluated; a miss of more than
     32 eps of the value (possible only when y^(k) T^k over- or underflows)
     gives an `AccuracyWarning` saying which derivative, at which end, by how much.
@@ -301,6 +325,7 @@ def poly_trajectory(T, start, end) -> PolyTrajectory:
     if start.size == 0:
         raise ValueError("start is empty: expected at least the value y(0) (and its derivatives).")
     traj = PolyTrajectory(T, start, end)
+    _check_finite(traj)
     _check_boundaries(traj)
     return traj
 

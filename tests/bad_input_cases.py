@@ -919,6 +919,12 @@ warns("place", "A scaled by 1e200", lambda: ck.place(A2 * 1e200, B2, P2), "poles
 
 bad("simulate", "Van der Pol stiff on the way, DOP853", lambda: ck.simulate(_vdp(1e4), np.linspace(0, 100, 11), x0=[1.0, 0.0],
                                                                            method="DOP853"), "method", also="stiff(?s:.*)Radau")
+ok("plan_robot", "T 1e300 (the slowest point overflowed)", lambda: _robot(T=1e300).min_speed)
+for _name, _call in (("poly_trajectory", lambda: ck.poly_trajectory(1e-300, [0.0, 0.0], [1.0, 0.0])(0.5e-300, k=2)),
+                     ("open_loop_control", lambda: _olc(T=1e-300).ud(0.5e-300)),
+                     ("plan_flat_output", lambda: _pflat(T=1e-300).u(0.5e-300)),
+                     ("plan_robot", lambda: _robot(T=1e-300).u(0.5e-300))):
+    bad(_name, "T 1e-300 (derivatives overflow)", _call, "T", also="out of reach")
 
 # ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"
