@@ -501,7 +501,8 @@ def float_array(value, name: str) -> np.ndarray:
     if arr.dtype.kind == "f":
         return arr
     if arr.dtype.kind == "c":
-        raise ValueError(f"{name} must contain real numbers: received complex entries.")
+        raise ValueError(f"{name} must contain real numbers: received complex entries; pass real numbers "
+                         "(np.real(...) when the imaginary parts are only rounding).")
     try:
         return arr.astype(float, copy=False)
     except (TypeError, ValueError) as err:

@@ -28,7 +28,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_flag, as_matrix, as_scalar, as_vector
+from ._validation import as_flag, as_matrix, as_scalar, as_vector, float_array
 from .controllability import as_pair, ccf_transform, charpoly
 from .diagnostics import warn_accuracy
 from .trajectory import PLAN_RTOL, input_time, plan_grid, plot_plan, poly_trajectory
@@ -92,7 +92,7 @@ class FlatSystem:
                 f"derivs must list F and its derivatives [F, F', ..., F^({order})] for the "
                 f"{self.name}: received {got}; expected at least {order + 1} entries."
             )
-        arrays = [np.asarray(d, dtype=float) for d in derivs[:order + 1]]
+        arrays = [float_array(d, f"derivs[{k}]") for k, d in enumerate(derivs[:order + 1])]
         # one time: a number, or shape (m,); with one flat output an (N,) array lists N times
         single = arrays[0].ndim == 0 or (arrays[0].ndim == 1 and (self.m > 1 or arrays[0].size == 1))
         out = []

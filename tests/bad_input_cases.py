@@ -926,6 +926,34 @@ for _name, _call in (("poly_trajectory", lambda: ck.poly_trajectory(1e-300, [0.0
                      ("plan_robot", lambda: _robot(T=1e-300).u(0.5e-300))):
     bad(_name, "T 1e-300 (derivatives overflow)", _call, "T", also="out of reach")
 
+def _sym_x():
+    return _sympy().Symbol("x", real=True)
+
+
+for _label, _expr, _discrete in (("-x + 10 sin(x)", lambda x: -x + 10 * _sympy().sin(x), False),
+                                 ("-x - sin(x), discrete", lambda x: -x - _sympy().sin(x), True)):
+    bad("symbolic_equilibria", f"no closed form: {_label}",
+        lambda _expr=_expr, _discrete=_discrete: ck.symbolic_equilibria([_expr(_sym_x())], [_sym_x()], discrete=_discrete),
+        "f", also="find_equilibria")
+bad("symbolic_equilibria", "f contains sympy.nan", lambda: ck.symbolic_equilibria([_sym_f()[0][0], _sympy().nan], _sym_f()[1]), "f")
+bad("symbolic_jacobian", "f contains sympy.nan", lambda: ck.symbolic_jacobian([_sym_f()[0][0] * _sympy().nan, 0], _sym_f()[1]), "f")
+bad("linearize_symbolic", "f contains sympy.nan", lambda: ck.linearize_symbolic([_sym_f()[0][0], _sympy().nan], _sym_f()[1], x_eq=[0, 0]), "f")
+bad("linearize_symbolic", "u_eq text", lambda: ck.linearize_symbolic(_sym_f()[0], _sym_f()[1][:1], u=_sym_f()[1][1:], x_eq=[0],
+                                                                    u_eq="a"), "u_eq")
+def _sym_square():
+    """Four state symbols as a 2x2 matrix (a mistake: variables are a list) and an f of them."""
+    X = _sympy().Matrix(2, 2, _sympy().symbols("x1:5"))
+    return [v ** 2 - 1 for v in X], X
+
+
+bad("symbolic_jacobian", "variables a 2x2 matrix", lambda: ck.symbolic_jacobian(*_sym_square()), "variables")
+bad("symbolic_equilibria", "unknowns a 2x2 matrix", lambda: ck.symbolic_equilibria(*_sym_square()), "unknowns")
+bad("linearize_symbolic", "x a 2x2 matrix", lambda: ck.linearize_symbolic(*_sym_square(), x_eq=[1, 1, 1, 1]), "x")
+for _label, _m in (("zero", 0.0), ("negative", -1.0)):
+    bad("symbolic_flat_maps", f"m {_label}", lambda _m=_m: ck.symbolic_flat_maps("pendulum", m=_m), "m")
+bad("FlatSystem", "psi_x derivs complex", lambda: ck.pendulum_flatness().psi_x([0.1 + 1j, 0.0]), "derivs")
+bad("FlatSystem", "psi_u derivs numpy complex", lambda: ck.pendulum_flatness().psi_u(np.array([0.1 + 1j, 0.0, 0.0])), "derivs")
+
 # ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"
 
