@@ -240,8 +240,10 @@ def as_series(value, name: str, *, samples: int, channels: int | None = None,
                      cols_why=channels_why)
 
 
-def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False) -> float:
-    """Return `value` as a finite float, optionally checking it is > 0 or whole."""
+def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False,
+              limit: float | None = None, limit_why: str = "") -> float:
+    """Return `value` as a finite float, optionally checking it is > 0, whole, or at most
+    `limit` in size (`limit_why` says why: "metres on a lecture-room floor")."""
     arr = _to_float_array(value, name)
     if arr.size != 1:
         raise ValueError(f"{name} must be a single number: received {_describe(value)}.")
@@ -250,6 +252,9 @@ def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False
         raise ValueError(f"{name} must be positive: received {x!r}, expected a number > 0.")
     if integer and x != round(x):
         raise ValueError(f"{name} must be a whole number: received {x!r}.")
+    if limit is not None and abs(x) > limit:
+        reason = f" ({limit_why})" if limit_why else ""
+        raise ValueError(f"{name} is out of range: received {x:g}, expected |{name}| <= {limit:g}{reason}.")
     return x
 
 

@@ -204,18 +204,29 @@ def pendulum_flatness(m: float = 1.0, l: float = 1.0, g: float = 9.81,
 
 
 def _speed_squared(D, name: str) -> np.ndarray:
-    """|F'|^2 of a planar robot, after checking it is away from the zero-speed singularity."""
+    """|F'|^2 of a planar robot, after checking it is away from the zero-speed singularity
+    and inside the float range (the turn rate (2.101) divides by it)."""
     dF = D[1]
-    speed_sq = np.sum(dF**2, axis=1, keepdims=True)
-    scale = max(1.0, float(np.sqrt(speed_sq.max())))
-    if np.any(np.sqrt(speed_sq) <= 1e-9 * scale):
-        k = int(np.argmin(speed_sq))
+    speed = np.hypot.reduce(dF, axis=1)   # without overflow in the squares of a fast plan
+    scale = max(1.0, float(speed.max()))
+    if np.any(speed <= 1e-9 * scale):
+        k = int(np.argmin(speed))
         raise ValueError(
             f"the flat parametrization of the {name} is singular at zero speed: at sample {k} "
-            f"F' = {dF[k].tolist()}, so |F'| = 0. The heading theta = atan2(F2', F1') (2.97) is "
+            f"F' = {dF[k].tolist()}, so |F'| = {float(speed[k]):.3g}, nothing beside the largest "
+            f"speed {scale:.3g} on the plan. The heading theta = atan2(F2', F1') (2.97) is "
             "the direction of motion and does not exist when the robot stands still, and the "
             "turn rate (2.101) divides by |F'|^2. Plan with a nonzero speed at both ends "
             "(e.g. plan_robot(..., speed=1.0)) so that F' never vanishes on [0, T]."
+        )
+    with np.errstate(over="ignore"):
+        speed_sq = (speed ** 2)[:, None]
+    if not np.isfinite(speed_sq).all():
+        raise ValueError(
+            f"the planned speed |F'| of the {name} reaches {scale:.3g}, and its square, by which the "
+            "turn rate (2.101) divides, leaves the float range: the end pose or the speed is far "
+            "too large for the horizon; plan distances and speeds of a physical size (metres, "
+            "metres per second)."
         )
     return speed_sq
 

@@ -953,6 +953,12 @@ for _label, _m in (("zero", 0.0), ("negative", -1.0)):
     bad("symbolic_flat_maps", f"m {_label}", lambda _m=_m: ck.symbolic_flat_maps("pendulum", m=_m), "m")
 bad("FlatSystem", "psi_x derivs complex", lambda: ck.pendulum_flatness().psi_x([0.1 + 1j, 0.0]), "derivs")
 bad("FlatSystem", "psi_u derivs numpy complex", lambda: ck.pendulum_flatness().psi_u(np.array([0.1 + 1j, 0.0, 0.0])), "derivs")
+bad("explorers.planner_compute", "r 10**9", lambda: xp2.planner_compute(r=10**9), "r")
+ok("explorers.pair_poles", "zeta 1e300 (zeta**2 overflowed)", lambda: xp3.pair_poles(2.0, 1e300))
+bad("explorers.pole_placement_compute", "zeta 1e300", lambda: xp3.pole_placement_compute(zeta=1e300), "zeta")
+bad("explorers.observer_noise_compute", "noise_std 1e300", lambda: xp4.observer_noise_compute(1.0, 1e300), "noise_std")
+for _arg in ("x_T", "y_T", "speed"):
+    bad("explorers.robot_planner_compute", f"{_arg} 1e300", lambda _arg=_arg: xp2.robot_planner_compute(**{_arg: 1e300}), _arg)
 
 # ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"
