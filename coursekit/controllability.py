@@ -348,10 +348,23 @@ def charpoly(A) -> np.ndarray:
     """Characteristic polynomial det(sI - A) = s^n + a_{n-1} s^(n-1) + ... + a_0.
 
     Returns the ascending coefficients ``[a_0, ..., a_{n-1}]`` (the leading 1
-    is left out), the notes' order in (1.53) and (3.39).
+    is left out), the notes' order in (1.53) and (3.39). Coefficients beyond
+    the float range (a_0 = (-1)^n det A of an A scaled by 1e200) raise a
+    ValueError naming A; the CCF methods (`place_details`,
+    `place_observer_details`, `linear_flatness`) check this first.
     """
     A = as_square(A, "A")
-    return np.real(np.poly(A))[::-1][:-1].copy()
+    with np.errstate(over="ignore", invalid="ignore"):
+        a = np.real(np.poly(A))[::-1][:-1].copy()
+    if not np.isfinite(a).all():
+        rho = float(np.abs(np.linalg.eigvals(A)).max())
+        raise ValueError(
+            f"A is too large for its characteristic polynomial det(sI - A) (1.53): its eigenvalues "
+            f"reach {rho:.3g}, and the coefficients a_k, sums of products of n - k of them "
+            f"(a_0 = (-1)^n det A), leave the float range (about 1.8e308). Express time in slower "
+            "units (the entries of A are rates, 1/time) so that they are nearer 1."
+        )
+    return a
 
 
 def _ccf_rows(v: Staircase) -> np.ndarray:

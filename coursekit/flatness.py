@@ -121,8 +121,8 @@ def linear_flatness(A, B) -> FlatSystem:
     """
     A, B = as_pair(A, B)
     n = A.shape[0]
+    a = charpoly(A)                # first: raises when its coefficients leave the float range
     T = ccf_transform(A, B)
-    a = charpoly(A)
     Lam = np.linalg.inv(T)
 
     def phi(X):

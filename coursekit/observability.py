@@ -24,7 +24,7 @@ import numpy as np
 
 from ._validation import as_matrix, as_poles, as_square
 from .diagnostics import NotObservableError
-from .controllability import (canonical_transform, check_tol, unit_free_staircase, ctrb_unchecked,
+from .controllability import (canonical_transform, charpoly, check_tol, unit_free_staircase, ctrb_unchecked,
                               marginal_note, Staircase)
 from .placement import place_gain, PoleMatch, require_finite, warn_if_missed, check_size, poly_from_roots
 
@@ -186,6 +186,7 @@ def place_observer_details(A, C, poles) -> ObserverDetails:
     A, C = as_obs_pair(A, C)
     n = A.shape[0]
     poles = as_poles(poles, "poles", count=n)
+    charpoly(A)                           # its coefficients, the OCF's last column, must be floats
     T = ocf_transform(A, C)
     V = np.linalg.inv(T)
     # (4.49): A~ = V^{-1} A V, C~ = C V

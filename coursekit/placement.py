@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import as_poles
-from .controllability import as_pair, numerical_rank, ccf_transform, require_controllable
+from .controllability import as_pair, charpoly, numerical_rank, ccf_transform, require_controllable
 from .diagnostics import NotControllableError, warn_accuracy
 
 __all__ = ["place", "place_details", "PlacementDetails", "poly_from_roots"]
@@ -92,6 +92,7 @@ def place_details(A, B, poles) -> PlacementDetails:
     A, B = as_pair(A, B)
     n = A.shape[0]
     poles = as_poles(poles, "poles", count=n)
+    charpoly(A)                    # its coefficients, the CCF's last row, must be floats
     T = ccf_transform(A, B)
     A_ccf = T @ A @ np.linalg.inv(T)
     a = -A_ccf[-1].copy()          # last row of the CCF is -[a_0 ... a_{n-1}]

@@ -959,6 +959,14 @@ bad("explorers.pole_placement_compute", "zeta 1e300", lambda: xp3.pole_placement
 bad("explorers.observer_noise_compute", "noise_std 1e300", lambda: xp4.observer_noise_compute(1.0, 1e300), "noise_std")
 for _arg in ("x_T", "y_T", "speed"):
     bad("explorers.robot_planner_compute", f"{_arg} 1e300", lambda _arg=_arg: xp2.robot_planner_compute(**{_arg: 1e300}), _arg)
+for _name, _call in (("charpoly", lambda: ck.charpoly(A2 * 1e200)),
+                     ("linear_flatness", lambda: ck.linear_flatness(A2 * 1e200, B2 * 1e200)),
+                     ("place_details", lambda: ck.place_details(A2 * 1e200, B2 * 1e200, P2)),
+                     ("place_observer_details", lambda: ck.place_observer_details(A2 * 1e200, C2 * 1e200, P2))):
+    bad(_name, "entries scaled by 1e200 (coefficients overflow)", _call, "A", also="float range")
+bad("simulate_with_noise", "unstable system overflows", lambda: ck.simulate_with_noise(
+    ck.StateSpace([[1.0]], [[1.0]], [[1.0]]), np.linspace(0.0, 1000.0, 1001), x0=[1.0], Q=[[1.0]], R=[[1.0]], seed=0),
+    "t", also="overflows by t")
 
 # ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"

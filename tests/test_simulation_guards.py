@@ -316,3 +316,14 @@ def test_any_run_stops_at_the_evaluation_bound(monkeypatch):
         with pytest.raises(ck.SimulationError, match=r"evaluated f 20,000 times and reached only t = "
                                                      r"[\d.]+ of 5000(?s:.*)method='Radau'"):
             run()
+
+
+def test_simulate_with_noise_refuses_a_state_that_overflows():
+    # issue 35: e^(t) passes 1e308 near t = 710; the noisy simulation returned inf without a word
+    unstable = ck.StateSpace([[1.0]], [[1.0]], [[1.0]])
+    with pytest.raises(ck.SimulationError, match=r"left the float range .* finite up to t = 709 .* overflows by "
+                                                 r"t = 710(?s:.*)unstable \(section 3\.2\.2\)"):
+        ck.simulate_with_noise(unstable, np.linspace(0.0, 1000.0, 1001), x0=[1.0], Q=[[1.0]], R=[[1.0]], seed=0)
+    # below the float limit the result is returned as before
+    res = ck.simulate_with_noise(unstable, np.linspace(0.0, 700.0, 701), x0=[1.0], Q=[[1.0]], R=[[1.0]], seed=0)
+    assert np.isfinite(res.x).all() and np.isfinite(res.y).all()
