@@ -31,6 +31,7 @@ __all__ = [
     "as_dt",
     "as_text",
     "as_flag",
+    "require_columns",
     "time_grid",
     "check_function_output",
     "call_user",
@@ -290,6 +291,14 @@ def as_flag(value, name: str, *, hint: str = "") -> bool:
         raise ValueError(f"{name} must be True or False: received {type(value).__name__} {value!r}"
                          + (f"; {hint}" if hint else "") + ".")
     return bool(value)
+
+
+def require_columns(shape: tuple, name: str = "B") -> None:
+    """Raise naming `name` when a matrix of this shape has no columns (an input matrix B of
+    shape (n, 0): no input to act with, almost always a slip such as B[:, 1:] of one column)."""
+    if shape[1] == 0:
+        raise ValueError(f"{name} has no columns: received shape {tuple(shape)}, expected at least one "
+                         "input column (shape (n, m) with m >= 1), e.g. [[0], [1]].")
 
 
 def as_text(value, name: str, *, expected: str = "a string") -> str:

@@ -71,7 +71,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import as_matrix, as_square
+from ._validation import as_matrix, as_square, require_columns
 from .diagnostics import NotControllableError, warn_accuracy
 from .systems import StateSpace, as_system
 
@@ -97,8 +97,7 @@ def as_pair(A, B):
     n = A.shape[0]
     B = as_matrix(B, "B", rows=n, rows_why=f"one per state, since A is {n}x{n}",
                   cols=1 if np.ndim(B) == 1 else None)
-    if B.shape[1] == 0:
-        raise ValueError("B has no columns: the system has no input to control it with.")
+    require_columns(B.shape, "B")
     return A, B
 
 

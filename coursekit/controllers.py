@@ -22,7 +22,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_square, as_vector, checked_call, float_array
+from ._validation import as_matrix, as_scalar, as_square, as_vector, checked_call, float_array, require_columns
 from .diagnostics import UserFunctionError
 from .systems import NonlinearSystem, StateSpace, as_system
 
@@ -190,6 +190,7 @@ def integral_augment(A, B, C=None, *, integrators: int = 1):
     n = A.shape[0]
     B = as_matrix(B, "B", rows=n, rows_why=f"one per state, since A is {n}x{n}",
                   cols=1 if np.ndim(B) == 1 else None)
+    require_columns(B.shape, "B")
     C = _output_matrix(C, n)
     q = _integrators(integrators)
     p, m = C.shape[0], B.shape[1]

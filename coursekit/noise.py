@@ -17,7 +17,7 @@ import numpy as np
 
 from ._filter_ode import records
 from ._validation import as_covariance, as_scalar, as_square, as_time_grid, as_vector, is_uniform
-from .simulation import SimulationResult, _check_finite, lti_step_matrices
+from .simulation import SimulationResult, _check_finite, _step_matrices
 from .systems import StateSpace, as_system
 
 __all__ = ["white_noise", "simulate_with_noise", "van_loan"]
@@ -117,7 +117,7 @@ def simulate_with_noise(sys, t, u=None, x0=None, *, Q, R, seed=None) -> Simulati
     x = np.empty((N, n))
     x[0] = x0
     if isinstance(sys, StateSpace):
-        Ad, B0, B1 = lti_step_matrices(sys.A, sys.B, dt)
+        Ad, B0, B1 = _step_matrices(sys.A, sys.B, dt)   # checked by StateSpace (B may have no columns)
         # white_noise samples have covariance intensity / dt, so intensity Qd dt gives Qd
         w = white_noise(t, _van_loan(sys.A, Q, dt)[1] * dt, rng)
         # everything but Ad x(k), for all k at once: B0 u(k) + B1 u(k+1) + w(k)

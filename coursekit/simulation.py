@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import (as_matrix, as_scalar, as_series, as_square, as_time_grid, as_vector, call_user,
-                          checked_call, is_uniform)
+                          checked_call, is_uniform, require_columns)
 from .diagnostics import SimulationError, UserFunctionError
 from .systems import NonlinearSystem, StateSpace, as_system, raw_field
 
@@ -571,6 +571,7 @@ def lti_step_matrices(A, B, h):
     n = A.shape[0]
     B = as_matrix(B, "B", rows=n, rows_why=f"one per state, since A is {n}x{n}",
                   cols=1 if np.ndim(B) == 1 else None)
+    require_columns(B.shape, "B")
     return _step_matrices(A, B, as_scalar(h, "h", positive=True))
 
 
@@ -578,15 +579,21 @@ def _step_matrices(A: np.ndarray, B: np.ndarray, h: float):
     """`lti_step_matrices` for checked arguments."""
     from scipy.linalg import expm
     n, m = B.shape
+    # The input blocks are linear in B: a B far larger than A h (B scaled by 1e200) would make
+    # expm square many more times and spoil Ad = e^(A h); B is brought to A h's size by a power
+    # of two (exact), and the blocks scaled back.
+    with np.errstate(over="ignore"):
+        ratio = float(np.abs(B).max(initial=0.0)) * h / max(1.0, float(np.abs(A).max(initial=0.0)) * h)
+    scale = 2.0 ** np.ceil(np.log2(ratio)) if ratio > 1.0 and np.isfinite(ratio) else 1.0
     M = np.zeros((n + 2 * m, n + 2 * m))
     M[:n, :n] = A * h
-    M[:n, n:n + m] = B * h
+    M[:n, n:n + m] = (B / scale) * h
     M[n:n + m, n + m:] = np.eye(m)
     with np.errstate(over="ignore", invalid="ignore"):   # an overflow is raised just below
         E = expm(M)
-    if not np.isfinite(E).all():
+        Ad, G0, G1 = E[:n, :n], E[:n, n:n + m] * scale, E[:n, n + m:] * scale
+    if not (np.isfinite(Ad).all() and np.isfinite(G0).all() and np.isfinite(G1).all()):
         raise _overflow(StateSpace(A), f"e^(A h) over one step h = {h:g} is already beyond it")
-    Ad, G0, G1 = E[:n, :n], E[:n, n:n + m], E[:n, n + m:]
     return Ad, G0 - G1, G1
 
 

@@ -71,12 +71,14 @@ def _dimensions(value) -> int:
 
 
 def _sym_pair(A, B):
+    from ._validation import require_columns
     A, B = _sym_matrix(A, "A"), _sym_matrix(B, "B")
     if not A.is_square or A.rows == 0:
         raise ValueError(f"A must be square: received shape {A.shape}, expected (n, n).")
     if B.rows != A.rows:
         raise ValueError(f"B has the wrong number of rows: received shape {B.shape}, "
                          f"expected {A.rows} rows (one per state, since A is {A.rows}x{A.rows}).")
+    require_columns(B.shape, "B")
     return A, B
 
 

@@ -967,6 +967,11 @@ for _name, _call in (("charpoly", lambda: ck.charpoly(A2 * 1e200)),
 bad("simulate_with_noise", "unstable system overflows", lambda: ck.simulate_with_noise(
     ck.StateSpace([[1.0]], [[1.0]], [[1.0]]), np.linspace(0.0, 1000.0, 1001), x0=[1.0], Q=[[1.0]], R=[[1.0]], seed=0),
     "t", also="overflows by t")
+for _name, _call in (("lti_step_matrices", lambda B: ck.lti_step_matrices(A2, B, 0.1)),
+                     ("integral_augment", lambda B: ck.integral_augment(A2, B, C2)),
+                     ("symbolic_ctrb", lambda B: ck.symbolic_ctrb(A2, B))):
+    bad(_name, "B of zero columns", lambda _call=_call: _call(np.zeros((2, 0))), "B", also="no columns")
+ok("lti_step_matrices", "B scaled by 1e200 (was refused as an overflow)", lambda: ck.lti_step_matrices(A2, B2 * 1e200, 0.1))
 
 # ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"

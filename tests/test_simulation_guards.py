@@ -327,3 +327,16 @@ def test_simulate_with_noise_refuses_a_state_that_overflows():
     # below the float limit the result is returned as before
     res = ck.simulate_with_noise(unstable, np.linspace(0.0, 700.0, 701), x0=[1.0], Q=[[1.0]], R=[[1.0]], seed=0)
     assert np.isfinite(res.x).all() and np.isfinite(res.y).all()
+
+
+@pytest.mark.parametrize("scale", [1e100, 1e200, 1e-200])
+def test_step_matrices_of_a_huge_or_tiny_input_matrix(scale):
+    # issue 35: with B scaled by 1e200, Ad differed from e^(A h) (or the overflow error blamed the
+    # input); the input blocks are linear in B, Ad does not depend on it
+    from scipy.linalg import expm
+    A, B, h = np.array([[0.0, 1.0], [-2.0, -3.0]]), np.array([[0.0], [1.0]]), 0.1
+    Ad, B0, B1 = ck.lti_step_matrices(A, B * scale, h)
+    Ad_1, B0_1, B1_1 = ck.lti_step_matrices(A, B, h)
+    np.testing.assert_allclose(Ad, expm(A * h), rtol=1e-14, atol=1e-15)
+    np.testing.assert_allclose(B0 / scale, B0_1, rtol=1e-13, atol=1e-16)
+    np.testing.assert_allclose(B1 / scale, B1_1, rtol=1e-13, atol=1e-16)
