@@ -278,6 +278,10 @@ def as_integer(value, name: str, *, minimum: int | None = None, why: str = "") -
     """Return `value` as an int, checking it is a finite whole number (>= `minimum`)."""
     if isinstance(value, (bool, np.bool_)):
         raise ValueError(f"{name} must be a whole number: received {value!r}.")
+    if isinstance(value, (list, tuple, np.ndarray)) and np.ndim(value) > 0:
+        # a count or an index: [0] is a list, not the number 0
+        raise ValueError(f"{name} must be a single whole number: received {_describe(value)}; "
+                         f"pass the number itself, e.g. {name}=0.")
     k = int(as_scalar(value, name, integer=True))
     if minimum is not None and k < minimum:
         reason = f" ({why})" if why else ""
@@ -293,12 +297,13 @@ def as_flag(value, name: str, *, hint: str = "") -> bool:
     return bool(value)
 
 
-def require_columns(shape: tuple, name: str = "B") -> None:
+def require_columns(shape: tuple, name: str = "B", *, each: str = "input") -> None:
     """Raise naming `name` when a matrix of this shape has no columns (an input matrix B of
     shape (n, 0): no input to act with, almost always a slip such as B[:, 1:] of one column)."""
     if shape[1] == 0:
         raise ValueError(f"{name} has no columns: received shape {tuple(shape)}, expected at least one "
-                         "input column (shape (n, m) with m >= 1), e.g. [[0], [1]].")
+                         f"column (one per {each}); look for a slice such as {name}[:, 1:] that "
+                         "left none.")
 
 
 def as_text(value, name: str, *, expected: str = "a string") -> str:

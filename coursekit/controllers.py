@@ -116,9 +116,10 @@ def _trajectory(func, name: str, size: int, what: str) -> Callable:
 
     def wrapped(t):
         try:
-            value = np.ravel(np.asarray(func(t), dtype=float))
-            if value.size == size and np.isfinite(value).all():
-                return value
+            value = np.ravel(np.asarray(func(t)))
+            # real numbers only: complex ones would lose their imaginary part with a mere warning
+            if value.dtype.kind in "fiu" and value.size == size and np.isfinite(value).all():
+                return value.astype(float, copy=False)
         except Exception as err:
             explain(t, err)
         explain(t)

@@ -26,7 +26,8 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_integer, as_scalar, as_series, as_time_grid, as_vector, call_user, time_grid
+from ._validation import (as_integer, as_scalar, as_series, as_time_grid, as_vector, call_user,
+                          require_columns, time_grid)
 from .controllability import as_pair, ccf_transform, charpoly
 from .diagnostics import warn_accuracy
 
@@ -330,17 +331,18 @@ def poly_trajectory(T, start, end) -> PolyTrajectory:
     return traj
 
 
-def _check_trajectory(traj) -> None:
+def _check_trajectory(traj, order: int) -> None:
+    """Call traj once at t = 0 for every derivative k = 0..order that (2.25) uses."""
     if not callable(traj):
         raise ValueError(
             f"traj must be a function traj(t, k) returning the k-th derivative of y_d at t: "
             f"received {type(traj).__name__}; build one with poly_trajectory(T, start, end)."
         )
-    value = call_user(traj, (0.0, 0), "traj", where="at t = 0 (k = 0), called once as a check")
-    if value.size != 1:
-        raise ValueError(
-            f"traj(0.0, 0) returned shape {value.shape}; expected one number (the desired output y_d(0))."
-        )
+    for k in range(order + 1):
+        value = call_user(traj, (0.0, k), "traj", where=f"at t = 0 (k = {k}), called once as a check")
+        if value.size != 1:
+            raise ValueError(f"traj(0.0, {k}) returned shape {value.shape}; expected one number (the "
+                             f"derivative y_d^({k})(0)).")
 
 
 def feedforward(a, b, traj: Callable) -> Callable:
@@ -353,7 +355,7 @@ def feedforward(a, b, traj: Callable) -> Callable:
 
     Returns ``ud(t)``: a number for a number, an array for an array of times.
     A `traj` that raises, or returns NaN/inf, text or None (checked once at
-    t = 0 and at every call of ``ud``) gives a `UserFunctionError` (a
+    t = 0 for every derivative k = 0..n, and at every call of ``ud``) gives a `UserFunctionError` (a
     ValueError) naming traj and the derivative asked for.
     """
     a = as_vector(a, "a")
@@ -361,8 +363,8 @@ def feedforward(a, b, traj: Callable) -> Callable:
     if b == 0:
         raise ValueError("b must be nonzero: received 0; with b = 0 the input does not enter "
                          "the plant (2.16) and no feedforward exists.")
-    _check_trajectory(traj)
     n = a.size
+    _check_trajectory(traj, n)
 
     def y(t, k):
         value = call_user(traj, (t, k), "traj", where=f"for the derivative k = {k} in feedforward's ud(t)")
@@ -474,6 +476,8 @@ def plot_plan(t, x, u, *, title: str):
     t = as_time_grid(t, "t")
     x = as_series(x, "x", samples=t.size)
     u = as_series(u, "u", samples=t.size)
+    require_columns(x.shape, "x", each="state")
+    require_columns(u.shape, "u", each="input")
     title = str(title)
     from .style import new_figure
     fig, (ax_x, ax_u) = new_figure(1, 2, figsize=(10, 3.6))

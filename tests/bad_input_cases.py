@@ -972,6 +972,13 @@ for _name, _call in (("lti_step_matrices", lambda B: ck.lti_step_matrices(A2, B,
                      ("symbolic_ctrb", lambda B: ck.symbolic_ctrb(A2, B))):
     bad(_name, "B of zero columns", lambda _call=_call: _call(np.zeros((2, 0))), "B", also="no columns")
 ok("lti_step_matrices", "B scaled by 1e200 (was refused as an overflow)", lambda: ck.lti_step_matrices(A2, B2 * 1e200, 0.1))
+bad("plot_plan", "x of zero columns", lambda: ck.plot_plan(T11, np.zeros((11, 0)), np.zeros((11, 1)), title="plan"), "x")
+bad("plot_plan", "u of zero columns", lambda: ck.plot_plan(T11, np.zeros((11, 2)), np.zeros((11, 0)), title="plan"), "u")
+bad("plot_state_plane", "labels a string for two trajectories", lambda: ck.plot_state_plane([result().x, result().x], labels="ab"),
+    "labels")
+bad("plot_euler_comparison", "state a list", lambda: ck.plot_euler_comparison(result(), [euler_result()], state=[0]), "state")
+bad("feedforward", "traj's second derivative NaN", lambda: ck.feedforward(
+    [2.0, 3.0], 1.0, lambda t, k=0: np.nan if k == 2 else 0.0), "traj")
 
 # ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"
