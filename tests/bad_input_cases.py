@@ -995,6 +995,9 @@ for _check, _count in _EXERCISE_ARGS.items():
         feedback(f"exercises.{_check}", _label,
                  lambda _check=_check, _count=_count, _value=_value: getattr(ex, _check)(*[_value] * _count), _says)
 
+# issue 35: a rank typed as text stays refused, with a message about the rank (not a matrix example)
+feedback("exercises.check_kalman_decision", "rank the string '2'", lambda: ex.check_kalman_decision("2", False),
+         r"rank must be a whole number, not text: received the string '2'; type the number without quotes")
 
 # ---------------------------------------------------------------------------
 # the worker
