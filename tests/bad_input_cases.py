@@ -979,6 +979,11 @@ bad("plot_state_plane", "labels a string for two trajectories", lambda: ck.plot_
 bad("plot_euler_comparison", "state a list", lambda: ck.plot_euler_comparison(result(), [euler_result()], state=[0]), "state")
 bad("feedforward", "traj's second derivative NaN", lambda: ck.feedforward(
     [2.0, 3.0], 1.0, lambda t, k=0: np.nan if k == 2 else 0.0), "traj")
+_A3, _B32 = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 2.0, 3.0]]), np.array([[0.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
+warns("place", "pole repeated 3 times with 2 inputs (one Jordan chain)", lambda: ck.place(_A3, _B32, [-2.0] * 3), "poles",
+      also="Jordan chain")
+warns("place_observer", "pole repeated 3 times with 2 outputs (one Jordan chain)",
+      lambda: ck.place_observer(_A3, _B32.T, [-2.0] * 3), "poles", also="Jordan chain")
 
 # ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"
