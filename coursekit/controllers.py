@@ -48,7 +48,11 @@ def _gain(K, name: str = "K") -> np.ndarray:
 def _states(x, n: int, name: str = "x", gain: str = "") -> np.ndarray:
     """x as one state (n,) or a batch (n, k) of states as columns (a column (n, 1) is a
     batch of one); other shapes raise ValueError (a row (1, n) or a wrong length would
-    broadcast into a wrong answer), which names `gain` ("K is 1x3") when given."""
+    broadcast into a wrong answer), which names `gain` ("K is 1x3") when given. A sympy
+    Matrix of numbers is a column by construction, but a student writes Matrix([1, 2]) for
+    the state vector: a sympy vector (n x 1 or 1 x n) is one state, as the same numbers in a list."""
+    if type(x).__module__.split(".")[0] == "sympy" and 1 in getattr(x, "shape", ()):
+        x = np.ravel(float_array(x, name))
     x = np.asarray(x)
     if x.dtype.kind != "f":
         x = float_array(x, name)

@@ -984,6 +984,21 @@ warns("place", "pole repeated 3 times with 2 inputs (one Jordan chain)", lambda:
       also="Jordan chain")
 warns("place_observer", "pole repeated 3 times with 2 outputs (one Jordan chain)",
       lambda: ck.place_observer(_A3, _B32.T, [-2.0] * 3), "poles", also="Jordan chain")
+warns("ccf_transform", "30 random states (the result is no CCF; the issue had 200)", lambda: ck.ccf_transform(
+    np.random.default_rng(0).normal(size=(30, 30)), np.random.default_rng(1).normal(size=(30, 1))), "A",
+    also="canonical form")
+
+def _same_answer(controller, x):
+    """controller(0, x) for x a sympy Matrix of numbers, which must equal the answer for the array."""
+    got, want = controller(0.0, _sympy().Matrix(x)), controller(0.0, np.array(x, dtype=float))
+    if np.shape(got) != np.shape(want) or not np.allclose(got, want, rtol=1e-15, atol=0):
+        raise AssertionError(f"a sympy Matrix gave {got!r}, the array {want!r}")
+    return got
+
+
+ok("StateFeedback", "x a sympy Matrix answers as the array", lambda: _same_answer(ck.StateFeedback(K2), [1, 2]))
+ok("PendulumLinearizingController", "x a sympy Matrix answers as the array",
+   lambda: _same_answer(ck.PendulumLinearizingController(P2), [1, 2]))
 
 # ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"
