@@ -45,6 +45,7 @@ x1, x2 = sp.symbols("x1 x2")
 SYMF = [x2, -sp.sin(x1)]
 T_ILL = np.array([[1.0, 1.0], [1.0, 1.0 + 1e-15]])
 ROT = np.linalg.qr(np.random.default_rng(3).normal(size=(3, 3)))[0]
+A3, B32 = np.array([[0, 1, 0], [0, 0, 1], [1, 2, 3.0]]), np.array([[0, 1], [1, 0], [0, 1.0]])
 '''
 
 # (kind, argument the message must name, call); kind: bad (an error), warn (an error or a
@@ -200,10 +201,8 @@ CALLS = [
     ("bad", "A", "ck.place_observer_details(A2 * 1e200, C2 * 1e200, P2)"),
     ("bad", "t", "ck.simulate_with_noise(ck.StateSpace([[1.0]], [[1.0]], [[1.0]]), np.linspace(0, 1000, 1001), "
      "x0=[1.0], Q=[[1.0]], R=[[1.0]], seed=0)", "float range"),
-    ("warn", "poles", "ck.place(np.array([[0, 1, 0], [0, 0, 1], [1, 2, 3.0]]), np.array([[0, 1], [1, 0], [0, 1.0]]), "
-     "[-2.0] * 3)"),
-    ("warn", "poles", "ck.place_observer(np.array([[0, 1, 0], [0, 0, 1], [1, 2, 3.0]]), np.array([[0, 1, 0], [1, 0, 1.0]]), "
-     "[-2.0] * 3)"),
+    ("warn", "poles", "ck.place(A3, B32, [-2.0] * 3)"),
+    ("warn", "poles", "ck.place_observer(A3, B32.T, [-2.0] * 3)"),
     ("warn", "A", "ck.ccf_transform(np.random.default_rng(0).normal(size=(30, 30)), "
      "np.random.default_rng(1).normal(size=(30, 1)))"),
     ("ok", "", "ck.lti_step_matrices(A2, B2 * 1e200, 0.1)"),
