@@ -45,6 +45,7 @@ x1, x2 = sp.symbols("x1 x2")
 SYMF = [x2, -sp.sin(x1)]
 T_ILL = np.array([[1.0, 1.0], [1.0, 1.0 + 1e-15]])
 ROT = np.linalg.qr(np.random.default_rng(3).normal(size=(3, 3)))[0]
+A3, B32 = np.array([[0, 1, 0], [0, 0, 1], [1, 2, 3.0]]), np.array([[0, 1], [1, 0], [0, 1.0]])
 '''
 
 # (kind, argument the message must name, call); kind: bad (an error), warn (an error or a
@@ -180,6 +181,48 @@ CALLS = [
     ("ok", "", "ck.place(A2 * 1e6, B2, P2)"),
     ("ok", "", "ck.similarity_transform(ck.StateSpace(A2, B2, C2), [[1.0, 1.0], [0.0, 1e-4]])"),
     ("ok", "", "ck.linearize(lambda x, u: np.array([(1.6 + x[0]) * 16.8 - 1.6 * 16.8]), [0.0])"),
+    # issue 35: a hang, raw errors, NaN/inf answers, malformed arguments, quiet misses
+    ("bad", "method", "ck.simulate(vdp(1e4), np.linspace(0, 100, 11), x0=[1.0, 0.0], method='DOP853')", "stiff"),
+    ("ok", "", "ck.plan_robot([0, 0, 0], [4, 2, 1.5], 1e300)"),
+    ("bad", "f", "ck.symbolic_equilibria([-x1 + 10 * sp.sin(x1)], [x1])", "find_equilibria"),
+    ("bad", "f", "ck.symbolic_equilibria([-x1 - sp.sin(x1)], [x1], discrete=True)", "find_equilibria"),
+    ("ok", "", "xp3.pair_poles(2.0, 1e300)"),
+    ("bad", "zeta", "xp3.pole_placement_compute(zeta=1e300)"),
+    ("bad", "noise_std", "xp4.observer_noise_compute(1.0, 1e300)"),
+    ("bad", "x_T", "xp2.robot_planner_compute(x_T=1e300)"),
+    ("bad", "speed", "xp2.robot_planner_compute(speed=1e300)"),
+    ("bad", "T", "ck.poly_trajectory(1e-300, [0.0, 0.0], [1.0, 0.0])"),
+    ("bad", "T", "ck.open_loop_control(A2, B2, [0, 0], [1, 0], 1e-300)"),
+    ("bad", "T", "ck.plan_flat_output(ck.pendulum_flatness(), 1e-300, [0.0, 0.0], [1.0, 0.0])"),
+    ("bad", "T", "ck.plan_robot([0, 0, 0], [4, 2, 1.5], 1e-300)"),
+    ("bad", "A", "ck.charpoly(A2 * 1e200)"),
+    ("bad", "A", "ck.linear_flatness(A2 * 1e200, B2 * 1e200)"),
+    ("bad", "A", "ck.place_details(A2 * 1e200, B2 * 1e200, P2)"),
+    ("bad", "A", "ck.place_observer_details(A2 * 1e200, C2 * 1e200, P2)"),
+    ("bad", "t", "ck.simulate_with_noise(ck.StateSpace([[1.0]], [[1.0]], [[1.0]]), np.linspace(0, 1000, 1001), "
+     "x0=[1.0], Q=[[1.0]], R=[[1.0]], seed=0)", "float range"),
+    ("warn", "poles", "ck.place(A3, B32, [-2.0] * 3)"),
+    ("warn", "poles", "ck.place_observer(A3, B32.T, [-2.0] * 3)"),
+    ("warn", "A", "ck.ccf_transform(np.random.default_rng(0).normal(size=(30, 30)), "
+     "np.random.default_rng(1).normal(size=(30, 1)))"),
+    ("ok", "", "ck.lti_step_matrices(A2, B2 * 1e200, 0.1)"),
+    ("bad", "B", "ck.lti_step_matrices(A2, np.zeros((2, 0)), 0.1)"),
+    ("bad", "B", "ck.integral_augment(A2, np.zeros((2, 0)), C2)"),
+    ("bad", "B", "ck.symbolic_ctrb(A2, np.zeros((2, 0)))"),
+    ("bad", "x", "ck.plot_plan(T11, np.zeros((11, 0)), U11, title='plan')"),
+    ("bad", "labels", "ck.plot_state_plane([np.zeros((3, 2)), np.ones((3, 2))], labels='ab')"),
+    ("bad", "state", "ck.plot_euler_comparison(ck.simulate(ck.StateSpace(A2, B2, C2), T11, u=U11 + 1), "
+     "[ck.simulate(ck.euler_discretize(ck.StateSpace(A2, B2, C2), 0.1), T11, u=U11 + 1)], state=[0])"),
+    ("bad", "x_d", "ck.TrackingController(K2, lambda t: np.zeros(2) + (1j if t > 1 else 0), "
+     "lambda t: np.zeros(1))(2.0, np.zeros(2))"),
+    ("bad", "traj", "ck.feedforward([2.0, 3.0], 1.0, lambda t, k=0: np.nan if k == 2 else 0.0)"),
+    ("bad", "f", "ck.symbolic_jacobian([x1 * sp.nan, x2], [x1, x2])"),
+    ("bad", "u_eq", "ck.linearize_symbolic([x2], [x1], u=[x2], x_eq=[0], u_eq='a')"),
+    ("bad", "variables", "ck.symbolic_jacobian([x1, x2, x1, x2], sp.Matrix(2, 2, sp.symbols('y1:5')))"),
+    ("bad", "m", "ck.symbolic_flat_maps('pendulum', m=0.0)"),
+    ("bad", "derivs", "ck.pendulum_flatness().psi_u(np.array([0.1 + 1j, 0.0, 0.0]))"),
+    ("ok", "", "ck.StateFeedback(K2)(0.0, sp.Matrix([1, 2])).shape == (1,) or 1 / 0"),
+    ("ok", "", "ck.PendulumLinearizingController(P2)(0.0, sp.Matrix([1, 2])).shape == (1,) or 1 / 0"),
 ]
 
 

@@ -31,6 +31,7 @@ __all__ = [
     "as_dt",
     "as_text",
     "as_flag",
+    "require_columns",
     "time_grid",
     "check_function_output",
     "call_user",
@@ -240,8 +241,10 @@ def as_series(value, name: str, *, samples: int, channels: int | None = None,
                      cols_why=channels_why)
 
 
-def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False) -> float:
-    """Return `value` as a finite float, optionally checking it is > 0 or whole."""
+def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False,
+              limit: float | None = None, limit_why: str = "") -> float:
+    """Return `value` as a finite float, optionally checking it is > 0, whole, or at most
+    `limit` in size (`limit_why` says why: "metres on a lecture-room floor")."""
     arr = _to_float_array(value, name)
     if arr.size != 1:
         raise ValueError(f"{name} must be a single number: received {_describe(value)}.")
@@ -250,6 +253,9 @@ def as_scalar(value, name: str, *, positive: bool = False, integer: bool = False
         raise ValueError(f"{name} must be positive: received {x!r}, expected a number > 0.")
     if integer and x != round(x):
         raise ValueError(f"{name} must be a whole number: received {x!r}.")
+    if limit is not None and abs(x) > limit:
+        reason = f" ({limit_why})" if limit_why else ""
+        raise ValueError(f"{name} is out of range: received {x:g}, expected |{name}| <= {limit:g}{reason}.")
     return x
 
 
@@ -272,6 +278,10 @@ def as_integer(value, name: str, *, minimum: int | None = None, why: str = "") -
     """Return `value` as an int, checking it is a finite whole number (>= `minimum`)."""
     if isinstance(value, (bool, np.bool_)):
         raise ValueError(f"{name} must be a whole number: received {value!r}.")
+    if isinstance(value, (list, tuple, np.ndarray)) and np.ndim(value) > 0:
+        # a count or an index: [0] is a list, not the number 0
+        raise ValueError(f"{name} must be a single whole number: received {_describe(value)}; "
+                         f"pass the number itself, e.g. {name}=0.")
     k = int(as_scalar(value, name, integer=True))
     if minimum is not None and k < minimum:
         reason = f" ({why})" if why else ""
@@ -285,6 +295,15 @@ def as_flag(value, name: str, *, hint: str = "") -> bool:
         raise ValueError(f"{name} must be True or False: received {type(value).__name__} {value!r}"
                          + (f"; {hint}" if hint else "") + ".")
     return bool(value)
+
+
+def require_columns(shape: tuple, name: str = "B", *, each: str = "input") -> None:
+    """Raise naming `name` when a matrix of this shape has no columns (an input matrix B of
+    shape (n, 0): no input to act with, almost always a slip such as B[:, 1:] of one column)."""
+    if shape[1] == 0:
+        raise ValueError(f"{name} has no columns: received shape {tuple(shape)}, expected at least one "
+                         f"column (one per {each}); look for a slice such as {name}[:, 1:] that "
+                         "left none.")
 
 
 def as_text(value, name: str, *, expected: str = "a string") -> str:
@@ -501,7 +520,8 @@ def float_array(value, name: str) -> np.ndarray:
     if arr.dtype.kind == "f":
         return arr
     if arr.dtype.kind == "c":
-        raise ValueError(f"{name} must contain real numbers: received complex entries.")
+        raise ValueError(f"{name} must contain real numbers: received complex entries; pass real numbers "
+                         "(np.real(...) when the imaginary parts are only rounding).")
     try:
         return arr.astype(float, copy=False)
     except (TypeError, ValueError) as err:

@@ -22,7 +22,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_matrix, as_scalar, as_square, as_vector, checked_call, float_array
+from ._validation import as_matrix, as_scalar, as_square, as_vector, checked_call, float_array, require_columns
 from .diagnostics import UserFunctionError
 from .systems import NonlinearSystem, StateSpace, as_system
 
@@ -48,7 +48,11 @@ def _gain(K, name: str = "K") -> np.ndarray:
 def _states(x, n: int, name: str = "x", gain: str = "") -> np.ndarray:
     """x as one state (n,) or a batch (n, k) of states as columns (a column (n, 1) is a
     batch of one); other shapes raise ValueError (a row (1, n) or a wrong length would
-    broadcast into a wrong answer), which names `gain` ("K is 1x3") when given."""
+    broadcast into a wrong answer), which names `gain` ("K is 1x3") when given. A sympy
+    Matrix of numbers is a column by construction, but a student writes Matrix([1, 2]) for
+    the state vector: a sympy vector (n x 1 or 1 x n) is one state, as the same numbers in a list."""
+    if type(x).__module__.split(".")[0] == "sympy" and 1 in getattr(x, "shape", ()):
+        x = np.ravel(float_array(x, name))
     x = np.asarray(x)
     if x.dtype.kind != "f":
         x = float_array(x, name)
@@ -116,9 +120,10 @@ def _trajectory(func, name: str, size: int, what: str) -> Callable:
 
     def wrapped(t):
         try:
-            value = np.ravel(np.asarray(func(t), dtype=float))
-            if value.size == size and np.isfinite(value).all():
-                return value
+            value = np.ravel(np.asarray(func(t)))
+            # real numbers only: complex ones would lose their imaginary part with a mere warning
+            if value.dtype.kind in "fiu" and value.size == size and np.isfinite(value).all():
+                return value.astype(float, copy=False)
         except Exception as err:
             explain(t, err)
         explain(t)
@@ -190,6 +195,7 @@ def integral_augment(A, B, C=None, *, integrators: int = 1):
     n = A.shape[0]
     B = as_matrix(B, "B", rows=n, rows_why=f"one per state, since A is {n}x{n}",
                   cols=1 if np.ndim(B) == 1 else None)
+    require_columns(B.shape, "B")
     C = _output_matrix(C, n)
     q = _integrators(integrators)
     p, m = C.shape[0], B.shape[1]

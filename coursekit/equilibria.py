@@ -257,4 +257,14 @@ def symbolic_equilibria(f, unknowns, *, discrete: bool = False):
     # simplify=False: sympy's general simplification of the intermediate equations is the slow
     # part (about 0.2 s for the pendulum (3.50)) and gives the same solutions for the
     # equilibria of the notes; each solution is still checked by substitution
-    return sp.solve(F, X, dict=True, simplify=False)
+    try:
+        return sp.solve(F, X, dict=True, simplify=False)
+    except NotImplementedError:
+        # transcendental equations such as -x + 10 sin(x) = 0 have no closed form
+        equation = "x = f(x) (3.53)" if discrete else "f = 0 (3.52)"
+        raise ValueError(
+            f"f: sympy finds no closed-form solution of {equation} for {X} (received the equations "
+            f"{F} = 0; one like x = 10 sin(x), which mixes x with a function of x, has none). Find "
+            "the equilibria numerically with find_equilibria(f, n=...), f a Python function f(x, u) "
+            f"(sympy.lambdify turns the expressions into one){', with dt=1 for x = f(x)' if discrete else ''}."
+        ) from None

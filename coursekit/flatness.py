@@ -28,7 +28,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_flag, as_matrix, as_scalar, as_vector
+from ._validation import as_flag, as_matrix, as_scalar, as_vector, float_array
 from .controllability import as_pair, ccf_transform, charpoly
 from .diagnostics import warn_accuracy
 from .trajectory import PLAN_RTOL, input_time, plan_grid, plot_plan, poly_trajectory
@@ -92,7 +92,7 @@ class FlatSystem:
                 f"derivs must list F and its derivatives [F, F', ..., F^({order})] for the "
                 f"{self.name}: received {got}; expected at least {order + 1} entries."
             )
-        arrays = [np.asarray(d, dtype=float) for d in derivs[:order + 1]]
+        arrays = [float_array(d, f"derivs[{k}]") for k, d in enumerate(derivs[:order + 1])]
         # one time: a number, or shape (m,); with one flat output an (N,) array lists N times
         single = arrays[0].ndim == 0 or (arrays[0].ndim == 1 and (self.m > 1 or arrays[0].size == 1))
         out = []
@@ -121,8 +121,8 @@ def linear_flatness(A, B) -> FlatSystem:
     """
     A, B = as_pair(A, B)
     n = A.shape[0]
+    a = charpoly(A)                # first: raises when its coefficients leave the float range
     T = ccf_transform(A, B)
-    a = charpoly(A)
     Lam = np.linalg.inv(T)
 
     def phi(X):
@@ -204,18 +204,29 @@ def pendulum_flatness(m: float = 1.0, l: float = 1.0, g: float = 9.81,
 
 
 def _speed_squared(D, name: str) -> np.ndarray:
-    """|F'|^2 of a planar robot, after checking it is away from the zero-speed singularity."""
+    """|F'|^2 of a planar robot, after checking it is away from the zero-speed singularity
+    and inside the float range (the turn rate (2.101) divides by it)."""
     dF = D[1]
-    speed_sq = np.sum(dF**2, axis=1, keepdims=True)
-    scale = max(1.0, float(np.sqrt(speed_sq.max())))
-    if np.any(np.sqrt(speed_sq) <= 1e-9 * scale):
-        k = int(np.argmin(speed_sq))
+    speed = np.hypot.reduce(dF, axis=1)   # without overflow in the squares of a fast plan
+    scale = max(1.0, float(speed.max()))
+    if np.any(speed <= 1e-9 * scale):
+        k = int(np.argmin(speed))
         raise ValueError(
             f"the flat parametrization of the {name} is singular at zero speed: at sample {k} "
-            f"F' = {dF[k].tolist()}, so |F'| = 0. The heading theta = atan2(F2', F1') (2.97) is "
+            f"F' = {dF[k].tolist()}, so |F'| = {float(speed[k]):.3g}, nothing beside the largest "
+            f"speed {scale:.3g} on the plan. The heading theta = atan2(F2', F1') (2.97) is "
             "the direction of motion and does not exist when the robot stands still, and the "
             "turn rate (2.101) divides by |F'|^2. Plan with a nonzero speed at both ends "
             "(e.g. plan_robot(..., speed=1.0)) so that F' never vanishes on [0, T]."
+        )
+    with np.errstate(over="ignore"):
+        speed_sq = (speed ** 2)[:, None]
+    if not np.isfinite(speed_sq).all():
+        raise ValueError(
+            f"the planned speed |F'| of the {name} reaches {scale:.3g}, and its square, by which the "
+            "turn rate (2.101) divides, leaves the float range: the end pose or the speed is far "
+            "too large for the horizon; plan distances and speeds of a physical size (metres, "
+            "metres per second)."
         )
     return speed_sq
 
@@ -496,7 +507,10 @@ def _slowest_point(plan: FlatPlan):
     P = np.polynomial.Polynomial
     # F_j as polynomials in the centred time s = 2 t / T - 1; F_j' in s is proportional to F_j' in t
     vel = [P(traj.coeffs).deriv() for traj in plan.trajectories]
-    speed_sq = sum(v * v for v in vel)
+    # one common scale (the roots do not change): F' ~ |F(T) - F(0)| or v T, whose square
+    # overflows for a horizon such as T = 1e300
+    scale = max(float(np.abs(v.coef).max()) for v in vel) or 1.0
+    speed_sq = sum((v / scale) * (v / scale) for v in vel)
     roots = speed_sq.deriv().roots()
     s = np.concatenate([[-1.0, 1.0], roots.real[(np.abs(roots.imag) < 1e-9) & (np.abs(roots.real) <= 1)]])
     k = int(np.argmin(speed_sq(s)))

@@ -27,7 +27,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import is_complex, as_dt, as_flag, as_scalar, as_vector, call_user, foreign_library
+from ._validation import is_complex, is_text, as_dt, as_flag, as_scalar, as_vector, call_user, foreign_library
 from .diagnostics import warn_accuracy
 from .systems import NonlinearSystem, StateSpace, as_system, raw_field
 
@@ -527,12 +527,24 @@ def sympy_column(values, name: str, *, allow_empty: bool = False):
     if len(M) == 0 and not allow_empty:
         raise ValueError(f"{name} is empty: expected at least one expression, e.g. [x1, x2] "
                          "from x1, x2 = sp.symbols('x1 x2').")
+    if min(M.shape) > 1:
+        raise ValueError(f"{name} must be a list (one row or one column): received a {M.shape[0]}x{M.shape[1]} "
+                         f"matrix; list the entries one after the other, e.g. [x1, x2, x3, x4].")
+    undefined = [v for v in (sp.nan, sp.zoo, sp.oo, -sp.oo) if M.has(v)]
+    if undefined:
+        raise ValueError(f"{name} contains {undefined[0]} (sympy's {'NaN' if undefined[0] is sp.nan else 'infinity'}): "
+                         f"received {list(M)!r}; look for a division by zero or a NaN where {name} "
+                         "was built, and pass finite expressions.")
     if M.shape[1] != 1:
         M = M.reshape(len(M), 1)
     return M
 
 
 def _values(values, size: int, name: str) -> list:
+    if is_text(values) or isinstance(values, (list, tuple)) and any(isinstance(v, str) for v in values):
+        # sympy would read a text as a new symbol ("a" -> a): never passed on
+        raise ValueError(f"{name} must contain numbers or sympy expressions: received the text {values!r}; "
+                         "write the values themselves, e.g. [0] or [sp.pi, 0], without quotes.")
     vals = list(values) if isinstance(values, (list, tuple)) else list(np.ravel(values))
     if is_complex(vals):
         raise ValueError(f"{name} must contain real values: received {vals!r} with complex entries; "

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import as_poles
-from .controllability import as_pair, numerical_rank, ccf_transform, require_controllable
+from .controllability import as_pair, charpoly, numerical_rank, ccf_transform, require_controllable
 from .diagnostics import NotControllableError, warn_accuracy
 
 __all__ = ["place", "place_details", "PlacementDetails", "poly_from_roots"]
@@ -31,6 +31,10 @@ __all__ = ["place", "place_details", "PlacementDetails", "poly_from_roots"]
 # orders of magnitude for ill-conditioning before warning, and a pole that is off by less than
 # a millionth of the largest pole is indistinguishable in any plot or simulation of the course.
 POLE_RTOL = 1e-6
+# The relative perturbation that rounding leaves on a closed loop of the course's sizes (n up to
+# 100, eigenvector conditions up to 1e2: 1e3 n eps ~ 1e-11, rounded down): a Jordan chain of
+# length L splits a repeated eigenvalue by about its L-th root.
+ROUNDING = 1e-12
 # The work of the multi-input methods grows fast with n: SciPy's Tits-Yang iteration takes about
 # 1.4 s at n = 20 and 8.5 s at n = 50 (it is tried up to _ROBUST_MAX_STATES states, Heymann's
 # lemma alone beyond), and the pole placement of more than _MULTI_INPUT_MAX_STATES states with
@@ -92,6 +96,7 @@ def place_details(A, B, poles) -> PlacementDetails:
     A, B = as_pair(A, B)
     n = A.shape[0]
     poles = as_poles(poles, "poles", count=n)
+    charpoly(A)                    # its coefficients, the CCF's last row, must be floats
     T = ccf_transform(A, B)
     A_ccf = T @ A @ np.linalg.inv(T)
     a = -A_ccf[-1].copy()          # last row of the CCF is -[a_0 ... a_{n-1}]
@@ -134,9 +139,14 @@ def place(A, B, poles) -> np.ndarray:
     assignment) and must agree to 1e-6 of the pole scale (the largest
     requested or achieved pole magnitude, or A's spectral radius if larger,
     so that deadbeat poles at 0 are judged fairly); a pole requested k times must have
-    its k eigenvalues average to it to 1e-6 and each lie within (1e-6)^(1/k)
-    of it, which is how far a relative perturbation of 1e-6 moves a k-fold
-    eigenvalue. Otherwise an `AccuracyWarning` gives the largest error and the
+    its k eigenvalues average to it to 1e-6 and, with one input, each lie
+    within (1e-6)^(1/k) of it, which is how far a relative perturbation of
+    1e-6 moves a k-fold eigenvalue. With r >= 2 independent inputs a gain
+    whose Jordan chains are at most ceil(k/r) long exists, and each eigenvalue
+    must lie within max(1e-6, 1e-12^(1/ceil(k/r))) (1e-6 for a pole
+    requested up to 2r times): Heymann's one-chain gain for a pole requested
+    more than r times scatters it by eps^(1/k) (1e-5 for k = 3) and is
+    reported. Otherwise an `AccuracyWarning` gives the largest error and the
     eigenvector condition number of A + B K. Some requests cannot be met in
     double precision by any method: for n = 20 and poles -1, ..., -20 even
     the exact gain, rounded to double, puts the poles off by orders of
@@ -203,12 +213,12 @@ def place_gain(A: np.ndarray, B: np.ndarray, poles: np.ndarray):
     tried = []
     robust = _robust(A, B_r, poles)
     if robust is not None:
-        tried.append((lift(robust), PoleMatch(A + B @ lift(robust), poles, A)))
+        tried.append((lift(robust), PoleMatch(A + B @ lift(robust), poles, A, inputs=r)))
         if tried[-1][1].ratio <= 1.0:
             return tried[-1]
     try:
         K = lift(_heymann(A, B_r, poles)[0])
-        tried.append((K, PoleMatch(A + B @ K, poles, A)))
+        tried.append((K, PoleMatch(A + B @ K, poles, A, inputs=r)))
     except NotControllableError:
         if not tried:
             raise
@@ -352,13 +362,19 @@ class PoleMatch:
     speed); all three are in the units of the poles, whatever the state units.
     A pole requested once must be hit to POLE_RTOL * scale. A pole requested
     k times is a k-fold eigenvalue, which any rounding splits into k
-    eigenvalues spread by about (perturbation)^(1/k): their mean must hit it
-    to POLE_RTOL * scale and each must lie within POLE_RTOL^(1/k) * scale.
+    eigenvalues spread by about (perturbation)^(1/L), L the length of its
+    longest Jordan chain: their mean must hit it to POLE_RTOL * scale. With
+    one input L = k, and each eigenvalue must lie within POLE_RTOL^(1/k) * scale.
+    With `inputs` = r >= 2 independent inputs a gain exists whose chains are
+    no longer than L = ceil(k / r); each eigenvalue must then lie within
+    max(POLE_RTOL, ROUNDING^(1/L)) * scale, the spread rounding explains for
+    such a gain (1e-6 for L <= 2): a gain that makes one long chain (a pole
+    requested 3 times with 2 inputs, split by 1e-5) is reported.
     ``ratio`` is the largest error divided by its tolerance (> 1: missed).
     """
 
-    def __init__(self, M: np.ndarray, poles: np.ndarray, A: np.ndarray | None = None):
-        self.M, self.poles = M, poles
+    def __init__(self, M: np.ndarray, poles: np.ndarray, A: np.ndarray | None = None, *, inputs: int = 1):
+        self.M, self.poles, self.inputs = M, poles, inputs
         if not np.all(np.isfinite(M)):                # an overflowed gain: nothing is placed
             self.achieved = self.errors = np.full(poles.shape, np.inf)
             self.scale, self.ratio = float(np.abs(poles).max()), np.inf
@@ -389,8 +405,14 @@ class PoleMatch:
             group, k = labels == j, counts[j]
             mean_error = abs(self.achieved[group].mean() - self.poles[j])
             ratio = max(ratio, mean_error / (POLE_RTOL * self.scale),
-                        self.errors[group].max() / (POLE_RTOL ** (1.0 / k) * self.scale))
+                        self.errors[group].max() / (self.spread_tolerance(k) * self.scale))
         return float(ratio) if np.isfinite(ratio) else np.inf
+
+    def spread_tolerance(self, k: int) -> float:
+        """How far (relative to the scale) each eigenvalue of a k-fold pole may lie from it."""
+        if self.inputs == 1:
+            return POLE_RTOL ** (1.0 / k)
+        return max(POLE_RTOL, ROUNDING ** (1.0 / -(-k // self.inputs)))
 
     def eigenvector_condition(self) -> float:
         """cond(V) of M = V diag(eig) V^-1 (unit columns): how sensitive its eigenvalues are."""
@@ -423,9 +445,23 @@ def warn_if_missed(match: PoleMatch, words: dict, stacklevel: int = 4) -> None:
         f"the pole scale {match.scale:.3g}, above the tolerance {POLE_RTOL:g}. The closed loop's "
         f"eigenvector condition number is {match.eigenvector_condition():.2g}: its eigenvalues "
         "move by about that times the rounding of its entries, so the problem is ill-conditioned "
-        f"in double precision. {words['advice']}.",
+        f"in double precision.{_chain_note(match)} {words['advice']}.",
         stacklevel=stacklevel,
     )
+
+
+def _chain_note(match: PoleMatch) -> str:
+    """For several inputs: the pole requested more often than there are inputs, and what to do."""
+    labels, counts = _groups(match.poles)
+    j = int(np.argmax(counts))
+    if match.inputs == 1 or counts[j] <= match.inputs:
+        return ""
+    return (f" The pole {_fmt(match.poles[j])} is requested {counts[j]} times with {match.inputs} "
+            f"independent inputs (outputs): this gain makes it one Jordan chain, whose eigenvalues "
+            f"rounding splits by about eps^(1/{counts[j]}), more than the tolerance "
+            f"{match.spread_tolerance(int(counts[j])):.2g} of a gain with chains of length "
+            f"{-(-int(counts[j]) // match.inputs)}; if the exact repetition is not needed, spread "
+            "the poles slightly (e.g. -1, -1.01, -0.99).")
 
 
 def _fmt(z: complex) -> str:

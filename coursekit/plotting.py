@@ -204,7 +204,8 @@ def plot_state_plane(trajectories, *, states=(0, 1), labels=None, state_names=No
     names = _names(state_names, "x", 2, "state_names") if state_names is not None else \
         [f"x{states[0] + 1}", f"x{states[1] + 1}"]
     units = _units(state_units, 2, "state_units")
-    labels = labels if labels is not None else [
+    # one string is one label (as for state_names), never split into its letters
+    labels = [labels] if isinstance(labels, str) else labels if labels is not None else [
         f"x(0) = [{pts[0, 0]:g}, {pts[0, 1]:g}]" for pts, _ in items]
     if len(labels) != len(items):
         raise ValueError(f"labels has {len(labels)} entries, expected {len(items)} (one per trajectory).")

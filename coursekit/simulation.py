@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._validation import (as_matrix, as_scalar, as_series, as_square, as_time_grid, as_vector, call_user,
-                          checked_call, is_uniform)
+                          checked_call, is_uniform, require_columns)
 from .diagnostics import SimulationError, UserFunctionError
 from .systems import NonlinearSystem, StateSpace, as_system, raw_field
 
@@ -127,7 +127,8 @@ def simulate(sys, t, u=None, x0=None, *, rtol: float = 1e-9, atol: float = 1e-12
         whatever is computed from it is meaningless; the error says up to
         which time the simulation is meaningful. Also raised, naming `method`,
         when the work would be unbounded: an explicit method on a stiff system
-        (refused before starting) or more than a million evaluations of f.
+        (refused before starting, or as soon as the stiffness appears on the
+        way) or more than a million evaluations of f.
     """
     sys = as_system(sys, hint="build one with StateSpace(A, B, C, D) or NonlinearSystem(f, n, m).")
     t = as_time_grid(t, "t", min_points=1 if sys.is_discrete else 2)
@@ -218,8 +219,9 @@ def _integrate_batch(model, t: np.ndarray, X0: np.ndarray, options: dict) -> np.
         X = last[1] = flat.reshape(n, k)
         last[0] = tk
         calls[0] += 1
-        if calls[0] > _MAX_EVALUATIONS:
-            raise _work_exceeded(model.sys, options, tk, t)
+        if calls[0] % _RECHECK_EVERY == 0:
+            _recheck(calls[0], lambda z: np.ravel(f(z[:, None], np.asarray(u(tk, z[:, None]), dtype=float)
+                                                    .reshape(m, 1))), t, X[:, 0].copy(), options, tk)
         try:
             F = np.asarray(f(X, np.asarray(u(tk, X), dtype=float).reshape(m, k)), dtype=float)
             if F.size == n * k and _screen(F):
@@ -569,6 +571,7 @@ def lti_step_matrices(A, B, h):
     n = A.shape[0]
     B = as_matrix(B, "B", rows=n, rows_why=f"one per state, since A is {n}x{n}",
                   cols=1 if np.ndim(B) == 1 else None)
+    require_columns(B.shape, "B")
     return _step_matrices(A, B, as_scalar(h, "h", positive=True))
 
 
@@ -576,15 +579,21 @@ def _step_matrices(A: np.ndarray, B: np.ndarray, h: float):
     """`lti_step_matrices` for checked arguments."""
     from scipy.linalg import expm
     n, m = B.shape
+    # The input blocks are linear in B: a B far larger than A h (B scaled by 1e200) would make
+    # expm square many more times and spoil Ad = e^(A h); B is brought to A h's size by a power
+    # of two (exact), and the blocks scaled back.
+    with np.errstate(over="ignore"):
+        ratio = float(np.abs(B).max(initial=0.0)) * h / max(1.0, float(np.abs(A).max(initial=0.0)) * h)
+    scale = 2.0 ** np.ceil(np.log2(ratio)) if ratio > 1.0 and np.isfinite(ratio) else 1.0
     M = np.zeros((n + 2 * m, n + 2 * m))
     M[:n, :n] = A * h
-    M[:n, n:n + m] = B * h
+    M[:n, n:n + m] = (B / scale) * h
     M[n:n + m, n + m:] = np.eye(m)
     with np.errstate(over="ignore", invalid="ignore"):   # an overflow is raised just below
         E = expm(M)
-    if not np.isfinite(E).all():
+        Ad, G0, G1 = E[:n, :n], E[:n, n:n + m] * scale, E[:n, n + m:] * scale
+    if not (np.isfinite(Ad).all() and np.isfinite(G0).all() and np.isfinite(G1).all()):
         raise _overflow(StateSpace(A), f"e^(A h) over one step h = {h:g} is already beyond it")
-    Ad, G0, G1 = E[:n, :n], E[:n, n:n + m], E[:n, n + m:]
     return Ad, G0 - G1, G1
 
 
@@ -744,42 +753,71 @@ def _recurse_complex(Ad: np.ndarray, x0: np.ndarray, terms) -> np.ndarray:
 
 
 # The solver's work is bounded without a clock. An explicit method on a stiff system takes
-# steps of about 1 / |lambda| (its stability limit), so a fastest rate |lambda| of the Jacobian
-# at x0 times the time span above _MAX_EXPLICIT_WORK (about ten seconds of stepping) is refused
-# before starting; any run is stopped after _MAX_EVALUATIONS evaluations of f (the stiffness can
-# also appear later on the trajectory, as in the Van der Pol oscillator).
-_EXPLICIT = ("RK45", "RK23", "DOP853")
-_MAX_EXPLICIT_WORK = 1e6
+# steps of about R / |lambda| (R: the method's stability interval on the negative real axis)
+# and evaluates f a fixed number of times per step, so its work is about
+# _EVALUATIONS_PER_UNIT * |lambda| * span evaluations of f, |lambda| the fastest rate of the
+# Jacobian. A run whose estimate at x0 exceeds _MAX_EVALUATIONS is refused before starting. The
+# stiffness can also appear later on the trajectory (the Van der Pol oscillator from x0 = [1, 0]),
+# so the estimate is repeated every _RECHECK_EVERY evaluations at the current state over the time
+# still to go, against the evaluations left; any run is stopped after _MAX_EVALUATIONS
+# evaluations of f whatever happens (about six seconds of a cheap f).
+#: evaluations per step / R, rounded down (the estimate errs on the side of running)
+_EVALUATIONS_PER_UNIT = {"RK23": 3 / 2.5, "RK45": 6 / 3.3, "DOP853": 12 / 6}
 _MAX_EVALUATIONS = 1_000_000
+_RECHECK_EVERY = 10_000
 
 
-def _check_explicit_work(field, t: np.ndarray, x0: np.ndarray, options: dict) -> None:
-    """Refuse an explicit method whose stability limit alone asks for > 1e6 |lambda| t steps.
-
-    `field(x)` is dx/dt at t[0] (with the input applied); its Jacobian at x0 gives |lambda|.
-    """
-    if options["method"] not in _EXPLICIT:
-        return
+def _fastest_rate(field, x: np.ndarray) -> float:
+    """|lambda|max of the Jacobian of `field` at x; NaN when it cannot be estimated there."""
     from .linearization import numerical_jacobian
     try:
         with np.errstate(all="ignore"):
-            J = numerical_jacobian(field, x0, refine=False)
-            rate = float(np.abs(np.linalg.eigvals(J)).max())
-    except Exception:  # f fails near x0: the guarded integration reports it
+            J = numerical_jacobian(field, x, refine=False)
+            return float(np.abs(np.linalg.eigvals(J)).max()) if np.isfinite(J).all() else math.nan
+    except Exception:  # f fails near x: the guarded integration reports it
+        return math.nan
+
+
+def _check_explicit_work(field, t: np.ndarray, x0: np.ndarray, options: dict, *,
+                         tk: float | None = None, calls: int = 0) -> None:
+    """Refuse an explicit method whose stability limit alone asks for more evaluations of f than
+    are left of `_MAX_EVALUATIONS` (`calls` made so far).
+
+    `field(x)` is dx/dt (with the input applied) at t[0], or at `tk` when the test is
+    repeated during the run at the current state x0; its Jacobian gives |lambda|. A rate that
+    cannot be estimated (NaN: f fails near x) refuses nothing: the guarded evaluations of f
+    report the failure, and the bound on evaluations still holds.
+    """
+    per_unit = _EVALUATIONS_PER_UNIT.get(options["method"])
+    if per_unit is None:   # an implicit method or the user's own OdeSolver
         return
-    span = float(t[-1] - t[0])
-    if rate * span > _MAX_EXPLICIT_WORK:
-        raise SimulationError(
-            f"method={options['method']!r} cannot finish in bounded work: the fastest mode of f at "
-            f"x0 has rate |lambda| = {rate:.3g}, so an explicit method needs steps of about "
-            f"1/|lambda| and roughly {rate * span / 4:.2g} of them over the {span:.3g} time units "
-            "of t. If that mode decays fast (a stiff system), pass method='Radau' or "
-            "method='LSODA', which take large steps there; if it oscillates, simulate a shorter "
-            "time span."
-        )
+    rate = _fastest_rate(field, x0)
+    span = float(t[-1] - (t[0] if tk is None else tk))
+    work = per_unit * rate * span
+    if not work > _MAX_EVALUATIONS - calls:   # NaN compares false
+        return
+    where = "at x0" if tk is None else f"at t = {tk:.6g}, x = {np.array2string(x0, precision=4)},"
+    became = "" if tk is None else (f" The system became stiff on the way (after {calls:,} evaluations "
+                                    "of f).")
+    raise SimulationError(
+        f"method={options['method']!r} cannot finish in bounded work: the fastest mode of f {where} "
+        f"has rate |lambda| = {rate:.3g}, so an explicit method needs steps of about 1/|lambda|, "
+        f"roughly {work:.2g} evaluations of f over the {span:.3g} time units "
+        f"{'of t' if tk is None else 'still to go'}, more than the {_MAX_EVALUATIONS - calls:,} left of "
+        f"the {_MAX_EVALUATIONS:,} a run may take.{became} If that mode decays fast (a stiff "
+        "system), pass method='Radau' or method='LSODA' (implicit methods), which take large "
+        "steps there; if it oscillates, simulate a shorter time span."
+    )
 
 
-def _work_exceeded(sys, options: dict, tk: float, t: np.ndarray) -> SimulationError:
+def _recheck(calls: int, field, t: np.ndarray, xk: np.ndarray, options: dict, tk: float) -> None:
+    """Every `_RECHECK_EVERY` evaluations: the stiffness test at the current state, then the bound."""
+    if calls >= _MAX_EVALUATIONS:
+        raise _work_exceeded(options, tk, t)
+    _check_explicit_work(field, t, xk, options, tk=tk, calls=calls)
+
+
+def _work_exceeded(options: dict, tk: float, t: np.ndarray) -> SimulationError:
     return SimulationError(
         f"the ODE solver (method={options['method']!r}) evaluated f {_MAX_EVALUATIONS:,} times "
         f"and reached only t = {tk:.6g} of {t[-1]:.6g}: the system is stiff or very fast there. "
@@ -803,8 +841,8 @@ def _integrate(model, t, x0, options: dict) -> np.ndarray:
     def rhs(tk, xk):
         last[0], last[1] = tk, xk
         calls[0] += 1
-        if calls[0] > _MAX_EVALUATIONS:
-            raise _work_exceeded(model.sys, options, tk, t)
+        if calls[0] % _RECHECK_EVERY == 0:
+            _recheck(calls[0], lambda z: f(z, u_fun(tk, z)), t, np.array(xk), options, tk)
         try:
             dx = f(xk, u_fun(tk, xk))
             # the fast test of `_screen`, inlined: this runs at every evaluation

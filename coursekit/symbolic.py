@@ -71,12 +71,14 @@ def _dimensions(value) -> int:
 
 
 def _sym_pair(A, B):
+    from ._validation import require_columns
     A, B = _sym_matrix(A, "A"), _sym_matrix(B, "B")
     if not A.is_square or A.rows == 0:
         raise ValueError(f"A must be square: received shape {A.shape}, expected (n, n).")
     if B.rows != A.rows:
         raise ValueError(f"B has the wrong number of rows: received shape {B.shape}, "
                          f"expected {A.rows} rows (one per state, since A is {A.rows}x{A.rows}).")
+    require_columns(B.shape, "B")
     return A, B
 
 
@@ -249,8 +251,9 @@ def _planar(car: bool):
     return name, derivs, psi_x, psi_u
 
 
-def _sym_parameter(value, key: str):
-    """A parameter value for `symbolic_flat_maps`: a real number or a sympy expression."""
+def _sym_parameter(value, key: str, *, positive: bool = False):
+    """A parameter value for `symbolic_flat_maps`: a real number or a sympy expression, > 0 when
+    `positive` (a mass, a length: the symbol is declared positive, and the maps divide by it)."""
     import sympy as sp
     from ._validation import is_complex, is_text
     if value is None or is_text(value) or is_complex(value):
@@ -263,6 +266,9 @@ def _sym_parameter(value, key: str):
     if not isinstance(expr, sp.Expr):
         raise ValueError(f"{key} must be a real number or a sympy expression: received {value!r}.")
     _check_real(expr, key)
+    if positive and expr.is_number and not bool(expr > 0):
+        raise ValueError(f"{key} must be positive: received {value!r}; it is a physical size (a mass, "
+                         "a length, gravity) that the maps divide by or take as > 0.")
     return expr
 
 
@@ -292,6 +298,6 @@ def symbolic_flat_maps(system: str, **params) -> SymbolicFlatMaps:
     for key, value in params.items():
         if key not in known:
             raise ValueError(f"{key} is not a parameter of the {name}: expected one of {sorted(known)}.")
-        value = _sym_parameter(value, key)
+        value = _sym_parameter(value, key, positive=bool(known[key].is_positive))
         psi_x, psi_u = psi_x.subs(known[key], value), psi_u.subs(known[key], value)
     return SymbolicFlatMaps(name, derivs, sp.Matrix(psi_x), sp.Matrix(psi_u))

@@ -26,7 +26,8 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_integer, as_scalar, as_series, as_time_grid, as_vector, call_user, time_grid
+from ._validation import (as_integer, as_scalar, as_series, as_time_grid, as_vector, call_user,
+                          require_columns, time_grid)
 from .controllability import as_pair, ccf_transform, charpoly
 from .diagnostics import warn_accuracy
 
@@ -273,6 +274,28 @@ def _check_boundaries(traj: PolyTrajectory) -> None:
     )
 
 
+def _check_finite(traj: PolyTrajectory) -> None:
+    """Raise naming T when a derivative of traj is inf or NaN somewhere on [0, T].
+
+    The k-th derivative scales like 1/T^k and the conditions in normalized time like
+    y^(k) T^k: for a T far from 1 (1e-300, 1e300) they leave the float range, and a plan
+    built on such a trajectory would hand out inf or NaN without a word.
+    """
+    t = traj.T * np.linspace(0.0, 1.0, _CENTRES + 1)
+    with np.errstate(all="ignore"):
+        for k in range(traj.degree + 1):
+            values = traj._eval(t, k)
+            if not np.isfinite(values).all():
+                bad = values[~np.isfinite(values)][0]
+                raise ValueError(
+                    f"T = {traj.T:g} is out of reach of double precision for this trajectory: its "
+                    f"derivative y^({k}) on [0, T] is {bad} (the k-th derivative scales like 1/T^k, "
+                    f"the boundary conditions in normalized time like y^(k) T^k, k up to "
+                    f"{traj.degree}). Express time in other units so that T is nearer 1 (ms, "
+                    "minutes, hours), or use fewer boundary conditions."
+                )
+
+
 def poly_trajectory(T, start, end) -> PolyTrajectory:
     """Polynomial trajectory from `start` at t = 0 to `end` at t = T.
 
@@ -289,7 +312,9 @@ def poly_trajectory(T, start, end) -> PolyTrajectory:
     Guarantees, for r up to 20 and any T whose powers T^k (k < 2r) stay in
     double range: each boundary value and derivative is met to a few units in
     the last place of its own value, and every derivative on [0, T] is within
-    about 50 eps of that derivative's largest value there. After building,
+    about 50 eps of that derivative's largest value there. A T for which a
+    derivative on [0, T] leaves the float range (inf or NaN) raises a
+    ValueError naming T. After building,
     the 2r boundary conditions are evaluated; a miss of more than
     32 eps of the value (possible only when y^(k) T^k over- or underflows)
     gives an `AccuracyWarning` saying which derivative, at which end, by how much.
@@ -301,21 +326,23 @@ def poly_trajectory(T, start, end) -> PolyTrajectory:
     if start.size == 0:
         raise ValueError("start is empty: expected at least the value y(0) (and its derivatives).")
     traj = PolyTrajectory(T, start, end)
+    _check_finite(traj)
     _check_boundaries(traj)
     return traj
 
 
-def _check_trajectory(traj) -> None:
+def _check_trajectory(traj, order: int) -> None:
+    """Call traj once at t = 0 for every derivative k = 0..order that (2.25) uses."""
     if not callable(traj):
         raise ValueError(
             f"traj must be a function traj(t, k) returning the k-th derivative of y_d at t: "
             f"received {type(traj).__name__}; build one with poly_trajectory(T, start, end)."
         )
-    value = call_user(traj, (0.0, 0), "traj", where="at t = 0 (k = 0), called once as a check")
-    if value.size != 1:
-        raise ValueError(
-            f"traj(0.0, 0) returned shape {value.shape}; expected one number (the desired output y_d(0))."
-        )
+    for k in range(order + 1):
+        value = call_user(traj, (0.0, k), "traj", where=f"at t = 0 (k = {k}), called once as a check")
+        if value.size != 1:
+            raise ValueError(f"traj(0.0, {k}) returned shape {value.shape}; expected one number (the "
+                             f"derivative y_d^({k})(0)).")
 
 
 def feedforward(a, b, traj: Callable) -> Callable:
@@ -328,7 +355,7 @@ def feedforward(a, b, traj: Callable) -> Callable:
 
     Returns ``ud(t)``: a number for a number, an array for an array of times.
     A `traj` that raises, or returns NaN/inf, text or None (checked once at
-    t = 0 and at every call of ``ud``) gives a `UserFunctionError` (a
+    t = 0 for every derivative k = 0..n, and at every call of ``ud``) gives a `UserFunctionError` (a
     ValueError) naming traj and the derivative asked for.
     """
     a = as_vector(a, "a")
@@ -336,8 +363,8 @@ def feedforward(a, b, traj: Callable) -> Callable:
     if b == 0:
         raise ValueError("b must be nonzero: received 0; with b = 0 the input does not enter "
                          "the plant (2.16) and no feedforward exists.")
-    _check_trajectory(traj)
     n = a.size
+    _check_trajectory(traj, n)
 
     def y(t, k):
         value = call_user(traj, (t, k), "traj", where=f"for the derivative k = {k} in feedforward's ud(t)")
@@ -449,6 +476,8 @@ def plot_plan(t, x, u, *, title: str):
     t = as_time_grid(t, "t")
     x = as_series(x, "x", samples=t.size)
     u = as_series(u, "u", samples=t.size)
+    require_columns(x.shape, "x", each="state")
+    require_columns(u.shape, "u", each="input")
     title = str(title)
     from .style import new_figure
     fig, (ax_x, ax_u) = new_figure(1, 2, figsize=(10, 3.6))

@@ -915,6 +915,85 @@ warns("place", "A scaled by 1e200", lambda: ck.place(A2 * 1e200, B2, P2), "poles
 
 
 # ---------------------------------------------------------------------------
+# issue 35: the tail after issue 25 (one hang, raw errors, NaN/inf answers, quiet misses)
+
+bad("simulate", "Van der Pol stiff on the way, DOP853", lambda: ck.simulate(_vdp(1e4), np.linspace(0, 100, 11), x0=[1.0, 0.0],
+                                                                           method="DOP853"), "method", also="stiff(?s:.*)Radau")
+ok("plan_robot", "T 1e300 (the slowest point overflowed)", lambda: _robot(T=1e300).min_speed)
+for _name, _call in (("poly_trajectory", lambda: ck.poly_trajectory(1e-300, [0.0, 0.0], [1.0, 0.0])(0.5e-300, k=2)),
+                     ("open_loop_control", lambda: _olc(T=1e-300).ud(0.5e-300)),
+                     ("plan_flat_output", lambda: _pflat(T=1e-300).u(0.5e-300)),
+                     ("plan_robot", lambda: _robot(T=1e-300).u(0.5e-300))):
+    bad(_name, "T 1e-300 (derivatives overflow)", _call, "T", also="out of reach")
+
+# symbolic_equilibria of equations without a closed form: tests/test_equilibria.py (sympy takes
+# seconds to give up, beyond this table's deadline on a loaded machine)
+bad("symbolic_equilibria", "f contains sympy.nan", lambda: ck.symbolic_equilibria([_sym_f()[0][0], _sympy().nan], _sym_f()[1]), "f")
+bad("symbolic_jacobian", "f contains sympy.nan", lambda: ck.symbolic_jacobian([_sym_f()[0][0] * _sympy().nan, 0], _sym_f()[1]), "f")
+bad("linearize_symbolic", "f contains sympy.nan", lambda: ck.linearize_symbolic([_sym_f()[0][0], _sympy().nan], _sym_f()[1], x_eq=[0, 0]), "f")
+bad("linearize_symbolic", "u_eq text", lambda: ck.linearize_symbolic(_sym_f()[0], _sym_f()[1][:1], u=_sym_f()[1][1:], x_eq=[0],
+                                                                    u_eq="a"), "u_eq")
+def _sym_square():
+    """Four state symbols as a 2x2 matrix (a mistake: variables are a list) and an f of them."""
+    X = _sympy().Matrix(2, 2, _sympy().symbols("x1:5"))
+    return [v ** 2 - 1 for v in X], X
+
+
+bad("symbolic_jacobian", "variables a 2x2 matrix", lambda: ck.symbolic_jacobian(*_sym_square()), "variables")
+bad("symbolic_equilibria", "unknowns a 2x2 matrix", lambda: ck.symbolic_equilibria(*_sym_square()), "unknowns")
+bad("linearize_symbolic", "x a 2x2 matrix", lambda: ck.linearize_symbolic(*_sym_square(), x_eq=[1, 1, 1, 1]), "x")
+for _label, _m in (("zero", 0.0), ("negative", -1.0)):
+    bad("symbolic_flat_maps", f"m {_label}", lambda _m=_m: ck.symbolic_flat_maps("pendulum", m=_m), "m")
+bad("FlatSystem", "psi_x derivs complex", lambda: ck.pendulum_flatness().psi_x([0.1 + 1j, 0.0]), "derivs")
+bad("FlatSystem", "psi_u derivs numpy complex", lambda: ck.pendulum_flatness().psi_u(np.array([0.1 + 1j, 0.0, 0.0])), "derivs")
+bad("explorers.planner_compute", "r 10**9", lambda: xp2.planner_compute(r=10**9), "r")
+ok("explorers.pair_poles", "zeta 1e300 (zeta**2 overflowed)", lambda: xp3.pair_poles(2.0, 1e300))
+bad("explorers.pole_placement_compute", "zeta 1e300", lambda: xp3.pole_placement_compute(zeta=1e300), "zeta")
+bad("explorers.observer_noise_compute", "noise_std 1e300", lambda: xp4.observer_noise_compute(1.0, 1e300), "noise_std")
+for _arg in ("x_T", "y_T", "speed"):
+    bad("explorers.robot_planner_compute", f"{_arg} 1e300", lambda _arg=_arg: xp2.robot_planner_compute(**{_arg: 1e300}), _arg)
+for _name, _call in (("charpoly", lambda: ck.charpoly(A2 * 1e200)),
+                     ("linear_flatness", lambda: ck.linear_flatness(A2 * 1e200, B2 * 1e200)),
+                     ("place_details", lambda: ck.place_details(A2 * 1e200, B2 * 1e200, P2)),
+                     ("place_observer_details", lambda: ck.place_observer_details(A2 * 1e200, C2 * 1e200, P2))):
+    bad(_name, "entries scaled by 1e200 (coefficients overflow)", _call, "A", also="float range")
+bad("simulate_with_noise", "unstable system overflows", lambda: ck.simulate_with_noise(
+    ck.StateSpace([[1.0]], [[1.0]], [[1.0]]), np.linspace(0.0, 1000.0, 1001), x0=[1.0], Q=[[1.0]], R=[[1.0]], seed=0),
+    "t", also="overflows by t")
+for _name, _call in (("lti_step_matrices", lambda B: ck.lti_step_matrices(A2, B, 0.1)),
+                     ("integral_augment", lambda B: ck.integral_augment(A2, B, C2)),
+                     ("symbolic_ctrb", lambda B: ck.symbolic_ctrb(A2, B))):
+    bad(_name, "B of zero columns", lambda _call=_call: _call(np.zeros((2, 0))), "B", also="no columns")
+ok("lti_step_matrices", "B scaled by 1e200 (was refused as an overflow)", lambda: ck.lti_step_matrices(A2, B2 * 1e200, 0.1))
+bad("plot_plan", "x of zero columns", lambda: ck.plot_plan(T11, np.zeros((11, 0)), np.zeros((11, 1)), title="plan"), "x")
+bad("plot_plan", "u of zero columns", lambda: ck.plot_plan(T11, np.zeros((11, 2)), np.zeros((11, 0)), title="plan"), "u")
+bad("plot_state_plane", "labels a string for two trajectories", lambda: ck.plot_state_plane([result().x, result().x], labels="ab"),
+    "labels")
+bad("plot_euler_comparison", "state a list", lambda: ck.plot_euler_comparison(result(), [euler_result()], state=[0]), "state")
+bad("feedforward", "traj's second derivative NaN", lambda: ck.feedforward(
+    [2.0, 3.0], 1.0, lambda t, k=0: np.nan if k == 2 else 0.0), "traj")
+_A3, _B32 = np.array([[0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [1.0, 2.0, 3.0]]), np.array([[0.0, 1.0], [1.0, 0.0], [0.0, 1.0]])
+warns("place", "pole repeated 3 times with 2 inputs (one Jordan chain)", lambda: ck.place(_A3, _B32, [-2.0] * 3), "poles",
+      also="Jordan chain")
+warns("place_observer", "pole repeated 3 times with 2 outputs (one Jordan chain)",
+      lambda: ck.place_observer(_A3, _B32.T, [-2.0] * 3), "poles", also="Jordan chain")
+warns("ccf_transform", "30 random states (the result is no CCF; the issue had 200)", lambda: ck.ccf_transform(
+    np.random.default_rng(0).normal(size=(30, 30)), np.random.default_rng(1).normal(size=(30, 1))), "A",
+    also="canonical form")
+
+def _same_answer(controller, x):
+    """controller(0, x) for x a sympy Matrix of numbers, which must equal the answer for the array."""
+    got, want = controller(0.0, _sympy().Matrix(x)), controller(0.0, np.array(x, dtype=float))
+    if np.shape(got) != np.shape(want) or not np.allclose(got, want, rtol=1e-15, atol=0):
+        raise AssertionError(f"a sympy Matrix gave {got!r}, the array {want!r}")
+    return got
+
+
+ok("StateFeedback", "x a sympy Matrix answers as the array", lambda: _same_answer(ck.StateFeedback(K2), [1, 2]))
+ok("PendulumLinearizingController", "x a sympy Matrix answers as the array",
+   lambda: _same_answer(ck.PendulumLinearizingController(P2), [1, 2]))
+
+# ---------------------------------------------------------------------------
 # exercises: feedback, never an exception and never "Correct"
 
 #: every check of the course (a new chapter's too) and the number of answers it takes
@@ -929,6 +1008,9 @@ for _check, _count in _EXERCISE_ARGS.items():
         feedback(f"exercises.{_check}", _label,
                  lambda _check=_check, _count=_count, _value=_value: getattr(ex, _check)(*[_value] * _count), _says)
 
+# issue 35: a rank typed as text stays refused, with a message about the rank (not a matrix example)
+feedback("exercises.check_kalman_decision", "rank the string '2'", lambda: ex.check_kalman_decision("2", False),
+         r"rank must be a whole number, not text: received the string '2'; type the number without quotes")
 
 # ---------------------------------------------------------------------------
 # the worker

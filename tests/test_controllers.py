@@ -245,3 +245,18 @@ def test_a_state_with_nan_or_inf_is_refused_naming_x(controller, x):
     # issue 25: u came back NaN without a word
     with pytest.raises(ValueError, match=r"^x contains NaN or infinite entries"):
         controller()(0.0, np.array(x))
+
+
+@pytest.mark.parametrize("which", ["x_d", "u_d"])
+def test_tracking_refuses_complex_references_later_on(which):
+    # issue 35: after t = 1 the reference turns complex; numpy dropped the imaginary part with
+    # only a ComplexWarning and the controller answered as if nothing had happened
+    import warnings
+    later = lambda size: (lambda t: np.zeros(size) + (1j if t > 1 else 0))  # noqa: E731
+    refs = dict(x_d=lambda t: np.zeros(2), u_d=lambda t: np.zeros(1))
+    refs[which] = later(2 if which == "x_d" else 1)
+    controller = ck.TrackingController(np.array([[-1.0, -2.0]]), refs["x_d"], refs["u_d"])
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")   # a student's notebook shows the warning at most once
+        with pytest.raises(ck.UserFunctionError, match=rf"{which} returned complex numbers at t = 2"):
+            controller(2.0, np.zeros(2))

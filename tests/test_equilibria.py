@@ -114,3 +114,16 @@ def test_a_model_undefined_at_some_guesses_still_finds_the_others():
     # sqrt is NaN for x < 0: the guess -2 fails quietly, the guess 3 finds x* = 4 (sqrt(x) = 2)
     X = ck.find_equilibria(lambda x, u: np.sqrt(x) - 2.0, None, [[-2.0], [3.0]])
     np.testing.assert_allclose(X, [[4.0]], atol=1e-9)
+
+
+@pytest.mark.parametrize("f, discrete, equation", [
+    (lambda x: -x + 10 * sp.sin(x), False, r"f = 0 \(3\.52\)"),
+    (lambda x: -x - sp.sin(x), True, r"x = f\(x\) \(3\.53\)"),
+])
+def test_an_equation_without_closed_form_points_to_find_equilibria(f, discrete, equation):
+    # issue 35: sympy's NotImplementedError reached the student; the solutions exist (x = 0 and
+    # about +-2.85 for the first) but only numerically
+    x = sp.Symbol("x", real=True)
+    with pytest.raises(ValueError, match=rf"^f: sympy finds no closed-form solution of {equation} for \[x\]"
+                                         r"(?s:.*)find_equilibria\(f, n=\.\.\.\)"):
+        ck.symbolic_equilibria([f(x)], [x], discrete=discrete)

@@ -135,7 +135,19 @@ def _as_1d(a):
     return arr.ravel() if arr.ndim == 2 and 1 in arr.shape else arr
 
 
-FORMS = {"list": _as_list, "array": np.asarray, "sympy": _as_sympy, "flat": _as_1d}
+def _as_complex(a):
+    """The answer as np.linalg.eig-based work gives it: complex dtype, imaginary parts zero."""
+    return np.asarray(a, dtype=float) + 0j
+
+
+def _as_complex_rounded(a):
+    """Complex, with imaginary parts of rounding size (1e-15 of the largest entry)."""
+    arr = np.asarray(a, dtype=float)
+    return arr + 1e-15j * max(1.0, float(np.abs(arr).max())) * np.cos(np.arange(arr.size)).reshape(arr.shape)
+
+
+FORMS = {"list": _as_list, "array": np.asarray, "sympy": _as_sympy, "flat": _as_1d,
+         "complex, zero imaginary parts": _as_complex, "complex, imaginary parts of rounding": _as_complex_rounded}
 
 
 @pytest.mark.parametrize("form", FORMS)
@@ -153,7 +165,16 @@ def test_answers_rounded_to_three_digits_are_accepted(name):
     assert _verdict(getattr(ex, name)(*args)) is True
 
 
+@pytest.mark.parametrize("name", ["check_ccf_transform", "check_gain_ccf", "check_observer_gain"])
+def test_complex_answers_with_real_imaginary_parts_stay_refused(name, capsys):
+    # issue 35 accepts imaginary parts of rounding size only: 1e-6 of the entries is a wrong answer
+    args = tuple(np.asarray(a, dtype=float) * (1 + 1e-6j) for a in RIGHT[name]())
+    assert _verdict(getattr(ex, name)(*args)) is False
+    assert "contains complex numbers" in capsys.readouterr().out
+
+
 def test_other_right_answers(capsys):
+    assert ex.check_kalman_decision(1 + 0j, False)   # complex dtype, zero imaginary part (issue 35)
     assert ex.check_pendulum_f(_pendulum_f)
     assert ex.check_pendulum_f(lambda x, u: np.array(_pendulum_f(x, np.atleast_1d(u))))  # u as a number
     assert ex.check_kalman_decision(1, False) and ex.check_kalman_decision(np.int64(1), "no")
@@ -164,7 +185,7 @@ def test_other_right_answers(capsys):
     assert ex.check_car_flatness(-v, -delta)   # driving backwards along the same path
     assert ex.check_car_flatness([v], np.array([delta]))
     assert ex.check_ctrb_matrix(sp.Matrix(_ctrb().astype(int)))
-    assert capsys.readouterr().out.count("Correct:") == 12
+    assert capsys.readouterr().out.count("Correct:") == 13
 
 
 def _swap(a):
@@ -365,7 +386,6 @@ def _with_nan(a):
 #: how a bad answer is made from the right one, and what the feedback must say about it
 BAD_FORMS = {
     "complex, right real part": (_complex_right_real, "complex"),
-    "complex, zero imaginary part": (lambda a: np.asarray(a, dtype=complex), "complex"),
     "complex list": (lambda a: (np.asarray(a, dtype=float) + 0.5j).tolist(), "complex"),
     "sympy complex": (_sympy_complex, "complex"),
     "NaN entry": (_with_nan, "NaN"),
@@ -391,7 +411,7 @@ def test_bad_answer_gets_feedback_naming_the_problem(name, form, capsys):
 
 
 @pytest.mark.parametrize("call, says", [
-    (lambda: ex.check_kalman_decision(1 + 0j, False), "complex"),
+    (lambda: ex.check_kalman_decision(1 + 1e-3j, False), "complex"),
     (lambda: ex.check_kalman_decision(1.5, False), "whole number"),
     (lambda: ex.check_kalman_decision(np.nan, False), "NaN"),
     (lambda: ex.check_vehicle_observability(1 + 1j, False), "complex"),

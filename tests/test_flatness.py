@@ -1,6 +1,5 @@
 """Flat outputs and the maps psi_x, psi_u (section 2.4)."""
 
-import re
 
 import numpy as np
 import pytest
@@ -184,14 +183,20 @@ def test_linear_flat_plan_meets_the_requested_states(n, seed, logT):
         np.testing.assert_allclose(plan.x(when), want, rtol=0, atol=1e-9 * max(1.0, np.abs(want).max()))
 
 
-def test_flat_plans_with_an_unrepresentable_horizon_warn():
+@pytest.mark.parametrize("T", [1e200, 1e-300])
+def test_flat_plans_with_an_unrepresentable_horizon_are_refused(T):
     flat = ck.pendulum_flatness()
-    # T^2 = 1e400 overflows: the planned F_d is NaN, and so are the plan's end states psi_x
-    with pytest.warns(ck.AccuracyWarning) as record:
-        ck.plan_flat_output(flat, 1e200, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0])
-    messages = [str(w.message) for w in record]
-    assert any(m.startswith("poly_trajectory misses") for m in messages)
-    assert any(re.match(r"plan_flat_output: the plan.s x\((0|T)\) = psi_x", m) for m in messages)
+    # T^2 = 1e400 overflows (the planned F_d would be NaN), or 1/T^2 does (F_d'' would be inf)
+    with pytest.raises(ValueError, match=r"T = 1e[+-]\d+ is out of reach of double precision"):
+        ck.plan_flat_output(flat, T, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0])
+
+
+def test_robot_plan_over_a_huge_horizon_is_finite():
+    # issue 35: |F'|^2 overflowed in the search for the slowest point (LinAlgError)
+    plan = ck.plan_robot([0.0, 0.0, 0.0], [4.0, 2.0, 1.5], 1e300)
+    assert 0 < plan.min_speed <= 1.0
+    assert np.isfinite([plan.x(t) for t in np.linspace(0, 1e300, 7)]).all()
+    assert np.isfinite([plan.u(t) for t in np.linspace(0, 1e300, 7)]).all()
 
 
 def test_robot_plan_meets_the_requested_poses():

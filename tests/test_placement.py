@@ -72,8 +72,11 @@ def test_bad_poles(poles, message):
 def test_repeated_more_than_rank_b_and_uncontrollable():
     A = np.array([[0, 1, 0], [0, 0, 1], [1, 2, 3.0]])
     B = np.array([[0, 1], [1, 0], [0, 1.0]])
-    K = ck.place(A, B, [-2, -2, -2])          # more than rank(B) times: Heymann's lemma, no refusal
-    # a triple eigenvalue of a 3x3 matrix scatters by ~(eps ||A + B K||)^(1/3) ~ 1e-4 when computed
+    # more than rank(B) times: Heymann's lemma, no refusal; its gain makes one Jordan chain, whose
+    # triple eigenvalue scatters by ~(eps ||A + B K||)^(1/3) ~ 1e-4 when computed, while two inputs
+    # allow chains of length 2 (scatter ~1e-8): an AccuracyWarning says so (issue 35)
+    with pytest.warns(ck.AccuracyWarning, match=r"requested 3 times with 2 independent inputs .* one Jordan chain"):
+        K = ck.place(A, B, [-2, -2, -2])
     np.testing.assert_allclose(np.linalg.eigvals(A + B @ K), [-2, -2, -2], atol=1e-3)
     np.testing.assert_allclose(np.poly(A + B @ K), [1, 6, 12, 8], atol=1e-9 * np.abs(K).max() ** 3)
     with pytest.raises(ck.NotControllableError, match=r"not controllable"):

@@ -15,6 +15,8 @@ Every call below runs with CoursekitWarning turned into an error (pyproject filt
 so each case also asserts that no AccuracyWarning is raised for these well-posed problems.
 """
 
+import contextlib
+
 import numpy as np
 import pytest
 import scipy.signal
@@ -212,9 +214,22 @@ def test_ctrb_obsv_duality():
 # ------------------------------------------------------------------------------------------
 # Placement
 
+def _one_chain(B, poles):
+    """A context that expects the AccuracyWarning of a pole requested more often than B has
+    independent inputs (several of them): Heymann's gain makes it one Jordan chain, whose
+    eigenvalues eig scatters beyond the 1e-6 a gain with shorter chains keeps (issue 35);
+    for any other case no warning (it would be an error here)."""
+    rank = np.linalg.matrix_rank(B)
+    repeats = max(list(poles).count(p) for p in poles)
+    if rank > 1 and repeats > rank:
+        return pytest.warns(ck.AccuracyWarning, match=rf"requested {repeats} times with {rank} independent inputs")
+    return contextlib.nullcontext()
+
+
 @pytest.mark.parametrize("origin, A, B, poles", PLACEMENTS, ids=IDS)
 def test_place_meets_the_ported_poles(origin, A, B, poles):
-    K = ck.place(A, B, poles)            # no AccuracyWarning: it would be an error here
+    with _one_chain(B, poles):
+        K = ck.place(A, B, poles)
     assert K.shape == (B.shape[1], A.shape[0])
     assert_poles_met(A + B @ K, poles, A)
 
@@ -222,7 +237,8 @@ def test_place_meets_the_ported_poles(origin, A, B, poles):
 @pytest.mark.parametrize("origin, A, B, poles", PLACEMENTS, ids=IDS)
 def test_place_observer_meets_the_ported_poles_by_duality(origin, A, B, poles):
     # the transposed data as an observer problem: eig(A^T - L B^T) = poles
-    L = ck.place_observer(A.T, B.T, poles)
+    with _one_chain(B, poles):
+        L = ck.place_observer(A.T, B.T, poles)
     assert L.shape == (A.shape[0], B.shape[1])
     assert_poles_met(A.T - L @ B.T, poles, A)
     if B.shape[1] == 1:

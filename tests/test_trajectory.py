@@ -306,11 +306,19 @@ def test_coeffs_are_the_polynomial_in_the_centred_time_s():
 
 
 @pytest.mark.parametrize("T", [1e20, 1e-20])
-def test_unrepresentable_horizon_warns_and_says_why(T):
-    # T^19 is outside double range: y^(19) T^19 overflows (1e380) or underflows (1e-380)
-    with pytest.warns(ck.AccuracyWarning, match=r"poly_trajectory misses .* boundary conditions .*"
-                                                r"y\^\(k\) T\^k over- or underflows for T = 1e[+-]20"):
+def test_unrepresentable_horizon_is_refused_and_says_why(T):
+    # T^19 is outside double range: y^(19) T^19 overflows (1e380) or underflows (1e-380), and
+    # the derivatives on [0, T] are inf or NaN: refused naming T (issue 35: NaN was returned)
+    with pytest.raises(ValueError, match=r"T = 1e[+-]20 is out of reach of double precision .* y\^\(\d+\) "
+                                         r"on \[0, T\] is (inf|-inf|nan)(?s:.*)T is nearer 1"):
         ck.poly_trajectory(T, np.ones(20), np.zeros(20))
+
+
+@pytest.mark.parametrize("T", [1e-300, 1e-160])
+def test_a_tiny_horizon_with_finite_boundary_values_is_refused(T):
+    # the boundary values are met, but y'' ~ 1/T^2 overflows on [0, T] (issue 35: returned inf)
+    with pytest.raises(ValueError, match=r"T = 1e-\d+ is out of reach .* y\^\(2\) on \[0, T\] is (inf|-inf|nan)"):
+        ck.poly_trajectory(T, [0.0, 0.0], [1.0, 0.0])
 
 
 # ---- open-loop control checks its plan ----------------------------------------------------

@@ -137,11 +137,30 @@ def _has_text(value) -> bool:
     return any(isinstance(v, (str, bytes)) for v in entries)
 
 
+#: imaginary parts up to this fraction of the largest entry (at least 1) are rounding: what
+#: np.linalg.eig-based work leaves on a real answer (about 1e-16 of it, grown by a few products)
+IMAG_RTOL = 1e-10
+
+
+def _real_part(value) -> np.ndarray | None:
+    """The real part of a complex answer whose imaginary parts are all zero to rounding, else None."""
+    try:
+        z = np.asarray(value, dtype=complex)
+    except (TypeError, ValueError, OverflowError):
+        return None
+    if not np.isfinite(z).all():
+        return None
+    scale = max(1.0, float(np.abs(z).max(initial=0.0)))
+    return z.real.copy() if np.all(np.abs(z.imag) <= IMAG_RTOL * scale) else None
+
+
 def _to_array(value, name: str, report: Report, *, dtype=float) -> np.ndarray | None:
     """`value` as an array of numbers, or None with a message explaining why not.
 
     With the default real `dtype`, complex entries are reported (never dropped):
-    the answers of these exercises are real matrices.
+    the answers of these exercises are real matrices. A complex array whose
+    imaginary parts are all zero to rounding (`IMAG_RTOL` of its largest entry),
+    as np.linalg.eig-based work gives, is the real answer and is read as such.
     """
     if value is None or value is Ellipsis:
         report.add(f"{name} is empty (None): replace the placeholder with your answer.")
@@ -153,10 +172,13 @@ def _to_array(value, name: str, report: Report, *, dtype=float) -> np.ndarray | 
         report.add(f"{name} is a function: call it and pass its result (numbers), not the function.")
         return None
     if dtype is float and is_complex(value):
-        report.add(f"{name} contains complex numbers: the answer is real. If the imaginary parts are "
-                   "rounding noise from a computation (e.g. np.linalg.eig), pass np.real(...) of it; "
-                   "otherwise recheck the computation.")
-        return None
+        real = _real_part(value)
+        if real is None:
+            report.add(f"{name} contains complex numbers: the answer is real. If the imaginary parts are "
+                       "rounding noise from a computation (e.g. np.linalg.eig), pass np.real(...) of it; "
+                       "otherwise recheck the computation.")
+            return None
+        value = real
     if _has_text(value):
         report.add(f"{name} contains text: type numbers, e.g. [[1, 2], [3, 4]], not strings.")
         return None
@@ -373,9 +395,7 @@ def call_student_function(func: Callable, args: tuple, name: str, size: int,
     return arr
 
 
-def rank_decision_feedback(rank, decision, true_rank: int, n: int, report: Report, *,
-                           word: str, rank_hint: str, decision_hint: str) -> None:
-    """Check a rank and the yes/no decision "rank = n" of a Kalman criterion (W_c or W_o)."""
+def _rank_feedback(rank, true_rank: int, report: Report, rank_hint: str) -> None:
     inner = Report("rank")
     value = _to_array(rank, "rank", inner)
     if value is None or value.size != 1 or value.ravel()[0] != round(value.ravel()[0]):
@@ -383,6 +403,17 @@ def rank_decision_feedback(rank, decision, true_rank: int, n: int, report: Repor
         report.add(f"rank must be a whole number (np.linalg.matrix_rank): {shown}")
     elif value.ravel()[0] != true_rank:
         report.add(f"the rank is off: {rank_hint}")
+
+
+def rank_decision_feedback(rank, decision, true_rank: int, n: int, report: Report, *,
+                           word: str, rank_hint: str, decision_hint: str) -> None:
+    """Check a rank and the yes/no decision "rank = n" of a Kalman criterion (W_c or W_o)."""
+    if isinstance(rank, (str, bytes)):
+        # the exercise asks for a number, not words: "2" is refused, saying so plainly
+        report.add(f"rank must be a whole number, not text: received the string {rank!r}; type the number "
+                   "without quotes, or compute it with np.linalg.matrix_rank.")
+    else:
+        _rank_feedback(rank, true_rank, report, rank_hint)
     answer = read_decision(decision, word, report)
     if answer is not None and answer != (true_rank == n):
         report.add(f"the decision does not follow the criterion: {decision_hint}")

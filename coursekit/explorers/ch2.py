@@ -21,6 +21,8 @@ __all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robo
 
 #: the plant of the trajectory planner: mass-spring-damper (2.27) [kg, N s/m, N/m]
 PLANNER_PLANT = dict(m=1.0, d=0.5, k=2.0)
+#: the largest target coordinate [m] and end speed [m/s] of the robot planner (sliders: 6 m, 2 m/s)
+ROBOT_RANGE = 1e6
 
 
 def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0, r: int = 2,
@@ -41,7 +43,8 @@ def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0
         raise ValueError(f"mass_error must be above -100 %: received {mass_error!r} (the plant's mass "
                          "would be zero or negative).")
     m, d, k = PLANNER_PLANT["m"], PLANNER_PLANT["d"], PLANNER_PLANT["k"]
-    r = int(as_scalar(r, "r", positive=True, integer=True))
+    r = int(as_scalar(r, "r", positive=True, integer=True, limit=20,
+                      limit_why="poly_trajectory is exact to rounding for up to 20 conditions per end"))
     if r < 2:
         raise ValueError(f"r must be >= 2: received {r}; the two states y, y' need two boundary "
                          "conditions at each end (2.31).")
@@ -114,10 +117,13 @@ def robot_planner_compute(x_T: float = 4.0, y_T: float = 2.0, heading_deg: float
     When the plan is singular (zero speed), the paths are empty and
     ``message`` says why.
     """
-    x_T, y_T = as_scalar(x_T, "x_T"), as_scalar(y_T, "y_T")
+    # a manoeuvre of metres: far beyond, |F'|^2 leaves the float range and the planner's
+    # message about a singular plan would be the wrong explanation
+    room = dict(limit=ROBOT_RANGE, limit_why="the robot plans manoeuvres of metres at walking speed")
+    x_T, y_T = as_scalar(x_T, "x_T", **room), as_scalar(y_T, "y_T", **room)
     heading = np.deg2rad(as_scalar(heading_deg, "heading_deg"))
     T = as_scalar(T, "T", positive=True)
-    speed = as_scalar(speed, "speed")
+    speed = as_scalar(speed, "speed", **room)
     t = time_grid(T, samples, t_end_name="T")
     target = np.array([x_T, y_T, heading])
     empty = np.empty((0, 3))

@@ -49,8 +49,14 @@ def pair_poles(wn: float, zeta: float) -> np.ndarray:
     if zeta < 1:
         wd = wn * np.sqrt(1 - zeta**2)
         return np.array([-zeta * wn + 1j * wd, -zeta * wn - 1j * wd])
-    root = wn * np.sqrt(zeta**2 - 1)
-    return np.array([-zeta * wn + root, -zeta * wn - root], dtype=complex)
+    # sqrt(zeta^2 - 1) without squaring zeta (1e300**2 overflows); the slow root from the
+    # product of the roots, wn^2, so it keeps its digits when zeta is large
+    fast = -wn * (zeta + np.sqrt(zeta - 1) * np.sqrt(zeta + 1))
+    poles = np.array([wn * (wn / fast), fast], dtype=complex)
+    if not np.isfinite(poles).all():
+        raise ValueError(f"wn and zeta are out of range: wn = {wn:g}, zeta = {zeta:g} give a pole beyond the "
+                         "float range (about 2 zeta wn); pick values within the sliders' range.")
+    return poles
 
 
 def _gain_text(K) -> str:

@@ -53,7 +53,8 @@ def observer_noise_compute(speed: float, noise_std: float, *, seed: int = 0, t_e
     its initial size in the noise-free case).
     """
     speed = as_scalar(speed, "speed", positive=True)
-    noise_std = as_scalar(noise_std, "noise_std")
+    # its square, the intensity R = noise_std^2 dt, must stay in the float range
+    noise_std = as_scalar(noise_std, "noise_std", limit=1e6, limit_why="metres of GPS noise")
     if noise_std < 0:
         raise ValueError(f"noise_std must be >= 0: received {noise_std!r} (a standard deviation in m).")
     seed = as_integer(seed, "seed", minimum=0)
