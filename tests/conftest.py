@@ -1,9 +1,13 @@
-"""Shared test settings: hypothesis profiles and small helpers."""
+"""Shared test settings: hypothesis profiles, small helpers, and the suite's markers
+(``browser`` and ``notebooks``: tests/suite_plugin.py)."""
 
 import os
 
 import numpy as np
 from hypothesis import HealthCheck, settings
+
+# pytester: tests/test_suite_plugin.py runs small test sessions of its own
+pytest_plugins = ["pytester", "suite_plugin"]
 
 settings.register_profile("default", deadline=None, max_examples=60,
                           suppress_health_check=[HealthCheck.too_slow])

@@ -333,9 +333,7 @@ class Opened:
         assert self.errors == [], f"console errors: {self.errors}"
 
     def axe(self, selector: str) -> list[str]:
-        source = lab_harness.axe_source()
-        assert source, "axe-core is not installed: npm install axe-core (or set AXE_CORE_JS); .ci/run does it"
-        return lab_harness.axe_violations(self.page, selector, source)
+        return lab_harness.axe_violations(self.page, selector, lab_harness.axe_source())
 
 
 @pytest.fixture

@@ -1,0 +1,89 @@
+"""The test suite's own set-up: axe-core from the dev extra, the browser tests skipped with one
+line when no Chromium is here (tests/suite_plugin.py), and the ``notebooks`` marker's lists."""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+
+import pytest
+
+import lab_harness
+import suite_plugin
+
+_BROWSER_TESTS = """
+import pytest
+
+pytestmark = pytest.mark.browser
+
+def test_{name}_one():
+    pass
+
+def test_{name}_two():
+    pass
+"""
+
+
+def test_axe_core_comes_with_the_dev_extra(monkeypatch):
+    monkeypatch.delenv("AXE_CORE_JS", raising=False)
+    assert re.match(r"/\*! axe v4\.\d+", lab_harness.axe_source())
+
+
+def test_axe_core_js_chooses_another_axe_core(monkeypatch, tmp_path):
+    other = tmp_path / "axe.min.js"
+    other.write_text("/*! axe v4.99.0 */ window.axe = {};", encoding="utf-8")
+    monkeypatch.setenv("AXE_CORE_JS", str(other))
+    assert lab_harness.axe_source() == other.read_text(encoding="utf-8")
+
+
+def test_axe_core_js_naming_no_file_says_so(monkeypatch, tmp_path):
+    monkeypatch.setenv("AXE_CORE_JS", str(tmp_path / "missing.js"))
+    with pytest.raises(lab_harness.HarnessError, match=r"AXE_CORE_JS is set to .*missing\.js.*not a file"):
+        lab_harness.axe_source()
+
+
+def test_without_chromium_the_browser_tests_skip_with_one_line(pytester, monkeypatch):
+    monkeypatch.setattr(lab_harness, "chromium_path", lambda: None)
+    pytester.makeini("[pytest]\nmarkers =\n    browser: b\n    notebooks: n\n")
+    pytester.makepyfile(test_lab=_BROWSER_TESTS.format(name="lab"), test_site=_BROWSER_TESTS.format(name="site"),
+                        test_unit="def test_unit():\n    pass\n")
+    result = pytester.runpytest("-p", "suite_plugin")
+    result.assert_outcomes(passed=1, skipped=4)
+    lines = [line for line in result.outlines if "Chromium" in line]
+    assert lines == ["4 browser tests skipped: Chromium is not installed: apt-get install chromium (Debian, "
+                     "Ubuntu), or python -m playwright install chromium where downloads are allowed"], lines
+
+
+def test_with_everything_there_no_skip_line_is_written(pytester, monkeypatch):
+    monkeypatch.setattr(lab_harness, "missing_reason", lambda: None)
+    pytester.makeini("[pytest]\nmarkers =\n    browser: b\n    notebooks: n\n")
+    pytester.makepyfile(test_lab=_BROWSER_TESTS.format(name="lab"))
+    result = pytester.runpytest("-p", "suite_plugin")
+    result.assert_outcomes(passed=2)
+    assert not [line for line in result.outlines if "browser tests skipped" in line]
+
+
+def _defined(pattern: str) -> set[str]:
+    """Names of the functions of tests/ whose `def` line matches `pattern` (one group: the name)."""
+    return {name for path in Path(__file__).parent.glob("test_*.py")
+            for name in re.findall(pattern, path.read_text(encoding="utf-8"), re.MULTILINE)}
+
+
+def test_the_notebook_tests_named_in_the_plugin_exist():
+    # a renamed test or fixture would otherwise drop out of the marker into the fast loop
+    for entry in suite_plugin.NOTEBOOK_TESTS:
+        module, name = entry.split("::")
+        source = (Path(__file__).parent / module).read_text(encoding="utf-8")
+        assert re.search(rf"^def {name}\(", source, re.MULTILINE), entry
+    assert suite_plugin.NOTEBOOK_FIXTURES <= _defined(r"^@pytest\.fixture.*\n(?:@.*\n)*def (\w+)\(")
+
+
+def test_notebook_tests_carry_the_marker(pytester):
+    pytester.makeini("[pytest]\nmarkers =\n    browser: b\n    notebooks: n\n")
+    pytester.makepyfile(test_site="def test_small_build_instructor_site():\n    pass\n\n"
+                                  "def test_landing_page():\n    pass\n",
+                        test_other="import pytest\n\n@pytest.fixture\ndef release():\n    return 1\n\n"
+                                   "def test_reads_the_release(release):\n    pass\n")
+    result = pytester.runpytest("-p", "suite_plugin", "-m", "not notebooks", "-v")
+    result.assert_outcomes(passed=1, deselected=2)
+    result.stdout.fnmatch_lines(["*test_site.py::test_landing_page PASSED*"])
