@@ -4,6 +4,7 @@
 import os
 
 import numpy as np
+import pytest
 from hypothesis import HealthCheck, settings
 
 # pytester: tests/test_suite_plugin.py runs small test sessions of its own
@@ -19,3 +20,18 @@ def sorted_eig(values):
     """Eigenvalues sorted by real then imaginary part, for comparisons."""
     values = np.asarray(values, dtype=complex)
     return values[np.lexsort((values.imag.round(8), values.real.round(8)))]
+
+
+@pytest.fixture(scope="session")
+def executed_chapters(tmp_path_factory):
+    """edition ("instructor" or "student") -> its chapter notebooks executed, once per session
+    (tests/executed_chapters.py says with what and who reads them)."""
+    from executed_chapters import execute_edition
+    done = {}
+
+    def executed(edition: str):
+        if edition not in done:
+            done[edition] = execute_edition(edition, tmp_path_factory.mktemp(edition) / "edition")
+        return done[edition]
+
+    return executed

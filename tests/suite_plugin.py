@@ -25,7 +25,7 @@ NOTEBOOK_TESTS = {
     "test_slides.py::test_small_build_from_the_command_line_needs_no_network",
 }
 #: fixtures that execute notebooks (or hand out executed ones): every test using one is marked
-NOTEBOOK_FIXTURES = {"release", "graded", "extended"}
+NOTEBOOK_FIXTURES = {"executed_chapters", "release", "graded", "extended"}
 
 _BROWSER_SKIP = pytest.StashKey[tuple]()    # (reason, number of browser tests skipped)
 

@@ -64,8 +64,8 @@ def test_with_everything_there_no_skip_line_is_written(pytester, monkeypatch):
 
 
 def _defined(pattern: str) -> set[str]:
-    """Names of the functions of tests/ whose `def` line matches `pattern` (one group: the name)."""
-    return {name for path in Path(__file__).parent.glob("test_*.py")
+    """Names of the functions of the files of tests/ whose `def` line matches `pattern` (one group: the name)."""
+    return {name for path in Path(__file__).parent.glob("*.py")
             for name in re.findall(pattern, path.read_text(encoding="utf-8"), re.MULTILINE)}
 
 
