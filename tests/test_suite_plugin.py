@@ -1,15 +1,18 @@
 """The test suite's own set-up: axe-core from the dev extra, the browser tests skipped with one
-line when no Chromium is here (tests/suite_plugin.py), and the ``notebooks`` marker's lists."""
+line when no Chromium is here (tests/suite_plugin.py), the ``notebooks`` marker's lists, and the
+replay of the session's executed chapters into the slides' build (tests/executed_chapters.py)."""
 
 from __future__ import annotations
 
 import re
 from pathlib import Path
 
+import nbformat
 import pytest
 
 import lab_harness
 import suite_plugin
+from executed_chapters import replay_into
 
 _BROWSER_TESTS = """
 import pytest
@@ -87,3 +90,28 @@ def test_notebook_tests_carry_the_marker(pytester):
     result = pytester.runpytest("-p", "suite_plugin", "-m", "not notebooks", "-v")
     result.assert_outcomes(passed=1, deselected=2)
     result.stdout.fnmatch_lines(["*test_site.py::test_landing_page PASSED*"])
+
+
+def _ran(prelude: str, *sources: str):
+    """A notebook as nbclient leaves it: `prelude` then code cells `sources`, each with an output."""
+    cells = [nbformat.v4.new_code_cell(source, execution_count=i, outputs=[nbformat.v4.new_output(
+        "display_data", data={"text/plain": f"out {i}", "application/x-report": "{}"})])
+        for i, source in enumerate((prelude, *sources))]
+    nb = nbformat.v4.new_notebook(cells=cells)
+    nb.metadata["language_info"] = {"name": "python", "version": "3.11.7"}
+    return nb
+
+
+def test_replay_gives_the_shared_outputs_to_the_same_notebook_only():
+    shared = _ran("describe()\nreport()", "x = 1", "plot(x)")
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in ("describe()", "x = 1", "plot(x)")])
+    replay_into(nb, shared, drop=("application/x-report",))
+    assert [c.outputs[0]["data"] for c in nb.cells[1:]] == [{"text/plain": "out 1"}, {"text/plain": "out 2"}]
+    assert [c.execution_count for c in nb.cells] == [0, 1, 2] and nb.metadata["language_info"]["name"] == "python"
+    assert "application/x-report" in shared.cells[1].outputs[0]["data"], "the shared copy is left as it was"
+    changed = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in ("describe()", "x = 2", "plot(x)")])
+    with pytest.raises(AssertionError, match="cells differ"):
+        replay_into(changed, shared)
+    other_prelude = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in ("frames()", "x = 1", "plot(x)")])
+    with pytest.raises(AssertionError, match="prelude differs"):
+        replay_into(other_prelude, shared)
