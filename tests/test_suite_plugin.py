@@ -48,9 +48,9 @@ def test_axe_core_js_naming_no_file_says_so(monkeypatch, tmp_path):
 def test_without_chromium_the_browser_tests_skip_with_one_line(pytester, monkeypatch):
     monkeypatch.setattr(lab_harness, "chromium_path", lambda: None)
     pytester.makeini("[pytest]\nmarkers =\n    browser: b\n    notebooks: n\n")
-    pytester.makepyfile(test_lab=_BROWSER_TESTS.format(name="lab"), test_site=_BROWSER_TESTS.format(name="site"),
-                        test_unit="def test_unit():\n    pass\n")
-    result = pytester.runpytest("-p", "suite_plugin", "--import-mode=importlib")
+    pytester.makepyfile(test_ck_lab=_BROWSER_TESTS.format(name="lab"), test_ck_site=_BROWSER_TESTS.format(name="site"),
+                        test_ck_unit="def test_unit():\n    pass\n")
+    result = pytester.runpytest("-p", "suite_plugin")
     result.assert_outcomes(passed=1, skipped=4)
     lines = [line for line in result.outlines if "Chromium" in line]
     assert lines == ["4 browser tests skipped: Chromium is not installed: apt-get install chromium (Debian, "
@@ -60,8 +60,8 @@ def test_without_chromium_the_browser_tests_skip_with_one_line(pytester, monkeyp
 def test_with_everything_there_no_skip_line_is_written(pytester, monkeypatch):
     monkeypatch.setattr(lab_harness, "missing_reason", lambda: None)
     pytester.makeini("[pytest]\nmarkers =\n    browser: b\n    notebooks: n\n")
-    pytester.makepyfile(test_lab=_BROWSER_TESTS.format(name="lab"))
-    result = pytester.runpytest("-p", "suite_plugin", "--import-mode=importlib")
+    pytester.makepyfile(test_ck_lab=_BROWSER_TESTS.format(name="lab"))
+    result = pytester.runpytest("-p", "suite_plugin")
     result.assert_outcomes(passed=2)
     assert not [line for line in result.outlines if "browser tests skipped" in line]
 
@@ -81,25 +81,26 @@ def test_the_notebook_tests_named_in_the_plugin_exist():
     assert suite_plugin.NOTEBOOK_FIXTURES <= _defined(r"^@pytest\.fixture.*\n(?:@.*\n)*def (\w+)\(")
 
 
-def test_notebook_tests_and_sweeps_carry_their_markers_and_slow(pytester):
+def test_notebook_tests_and_sweeps_carry_their_markers_and_slow(pytester, monkeypatch):
+    # file names of their own: the suite's modules of the same names are imported already
+    monkeypatch.setattr(suite_plugin, "NOTEBOOK_TESTS", {"test_ck_site.py::test_small_build"})
+    monkeypatch.setattr(suite_plugin, "SWEEP_MODULES", {"test_ck_layout.py"})
     pytester.makeini("[pytest]\nmarkers =\n    browser: b\n    notebooks: n\n    sweeps: s\n    slow: l\n")
     pytester.makepyfile(
-        test_site="def test_small_build_instructor_site():\n    pass\n\ndef test_landing_page():\n    pass\n",
-        test_other="import pytest\n\n@pytest.fixture\ndef release():\n    return 1\n\n"
-                   "def test_reads_the_release(release):\n    pass\n",
-        test_figure_layout="import pytest\nfrom coursekit.tools.chapters import explorer_factories\n\n"
-                           "FACTORIES = list(explorer_factories().values())\n\n"
-                           "@pytest.mark.parametrize('factory', FACTORIES[:2])\ndef test_each(factory):\n    pass\n\n"
-                           "@pytest.mark.parametrize('name', [f.__name__ for f in FACTORIES[:1]] + ['plain'])\n"
-                           "def test_named(name):\n    pass\n")
-    fast = pytester.runpytest("-p", "suite_plugin", "--import-mode=importlib", "-m", "not slow", "-v")
+        test_ck_site="def test_small_build():\n    pass\n\ndef test_landing_page():\n    pass\n",
+        test_ck_other="import pytest\n\n@pytest.fixture\ndef release():\n    return 1\n\n"
+                      "def test_reads_the_release(release):\n    pass\n",
+        test_ck_layout="import pytest\nfrom coursekit.tools.chapters import explorer_factories\n\n"
+                       "FACTORIES = list(explorer_factories().values())\n\n"
+                       "@pytest.mark.parametrize('factory', FACTORIES[:2])\ndef test_each(factory):\n    pass\n\n"
+                       "@pytest.mark.parametrize('name', [f.__name__ for f in FACTORIES[:1]] + ['plain'])\n"
+                       "def test_named(name):\n    pass\n")
+    fast = pytester.runpytest("-p", "suite_plugin", "-m", "not slow", "-v")
     fast.assert_outcomes(passed=2, deselected=5)
-    fast.stdout.fnmatch_lines(["*test_site.py::test_landing_page PASSED*"])
+    fast.stdout.fnmatch_lines(["*test_ck_site.py::test_landing_page PASSED*"])
     fast.stdout.fnmatch_lines(["*test_named?plain? PASSED*"])
-    assert pytester.runpytest("-p", "suite_plugin", "--import-mode=importlib", "-m", "notebooks") \
-        .parseoutcomes()["passed"] == 2
-    assert pytester.runpytest("-p", "suite_plugin", "--import-mode=importlib", "-m", "sweeps") \
-        .parseoutcomes()["passed"] == 3
+    assert pytester.runpytest("-p", "suite_plugin", "-m", "notebooks").parseoutcomes()["passed"] == 2
+    assert pytester.runpytest("-p", "suite_plugin", "-m", "sweeps").parseoutcomes()["passed"] == 3
 
 
 def _ran(prelude: str, *sources: str):
