@@ -31,7 +31,14 @@ def executed_chapters(tmp_path_factory):
 
     def executed(edition: str):
         if edition not in done:
-            done[edition] = execute_edition(edition, tmp_path_factory.mktemp(edition) / "edition")
+            try:
+                done[edition] = execute_edition(edition, tmp_path_factory.mktemp(edition) / "edition")
+            except Exception as error:     # said once in full; the other tests say it again in short
+                done[edition] = f"executing the {edition} edition failed: {type(error).__name__}: " \
+                                f"{str(error)[:2000]}"
+                raise
+        if isinstance(done[edition], str):
+            pytest.fail(done[edition])
         return done[edition]
 
     return executed

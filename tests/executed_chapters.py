@@ -70,6 +70,7 @@ def execute_edition(edition: str, folder: Path) -> Executed:
 
 async def _execute_all(notebooks: list, paths: list[Path]) -> None:
     from nbclient import NotebookClient
+    from nbclient.exceptions import CellExecutionError
     gate = asyncio.Semaphore(os.cpu_count() or 1)
 
     async def run(nb, path):
@@ -77,7 +78,10 @@ async def _execute_all(notebooks: list, paths: list[Path]) -> None:
         client = NotebookClient(nb, km=this_python_kernel(asynchronous=True), timeout=600,
                                 store_widget_state=False, resources={"metadata": {"path": str(path.parent)}})
         async with gate:
-            await client.async_execute()
+            try:
+                await client.async_execute()
+            except CellExecutionError as error:
+                raise AssertionError(f"{path.name} failed in a cell:\n{error}") from None
 
     await asyncio.gather(*(run(nb, path) for nb, path in zip(notebooks, paths)))
 
