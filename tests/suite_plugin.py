@@ -17,7 +17,7 @@ import pytest
 import lab_harness
 
 __all__ = ["NOTEBOOK_TESTS", "NOTEBOOK_FIXTURES", "SWEEP_MODULES", "browser_skip_line", "pytest_collection_modifyitems",
-           "pytest_terminal_summary"]
+           "pytest_collection_finish", "pytest_terminal_summary"]
 
 #: the tests that execute notebooks besides nbval's, as "module::test" (every parametrization)
 NOTEBOOK_TESTS = {
@@ -53,9 +53,9 @@ def _sweeps(item, explorers: list) -> bool:
                for value in item.callspec.params.values())
 
 
+@pytest.hookimpl(tryfirst=True)      # before -m deselects by these markers
 def pytest_collection_modifyitems(config, items):
-    """Mark the notebook tests, the sweeps and all slow tests; skip the browser tests, saying why
-    once, when no browser is here."""
+    """Mark the notebook tests, the sweeps and all slow tests."""
     from coursekit.tools.chapters import explorer_factories
     explorers = list(explorer_factories().values())
     for item in items:
@@ -65,10 +65,14 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.sweeps)
         if any(item.get_closest_marker(name) for name in ("notebooks", "sweeps", "browser")):
             item.add_marker(pytest.mark.slow)
-    browser = [item for item in items if item.get_closest_marker("browser")]
+
+
+def pytest_collection_finish(session):
+    """Skip the browser tests that are to run, saying why once, when no browser is here."""
+    browser = [item for item in session.items if item.get_closest_marker("browser")]
     reason = lab_harness.missing_reason() if browser else None
     if reason:
-        config.stash[_BROWSER_SKIP] = (reason, len(browser))
+        session.config.stash[_BROWSER_SKIP] = (reason, len(browser))
         for item in browser:
             item.add_marker(pytest.mark.skip(reason=reason))
 

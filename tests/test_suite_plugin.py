@@ -55,6 +55,10 @@ def test_without_chromium_the_browser_tests_skip_with_one_line(pytester, monkeyp
     lines = [line for line in result.outlines if "Chromium" in line]
     assert lines == ["4 browser tests skipped: Chromium is not installed: apt-get install chromium (Debian, "
                      "Ubuntu), or python -m playwright install chromium where downloads are allowed"], lines
+    # the count is of the browser tests that were to run
+    one = pytester.runpytest("-p", "suite_plugin", "-k", "lab_one or unit")
+    one.assert_outcomes(passed=1, skipped=1, deselected=3)
+    assert [line for line in one.outlines if "browser tests skipped" in line][0].startswith("1 browser tests")
 
 
 def test_with_everything_there_no_skip_line_is_written(pytester, monkeypatch):
