@@ -1,10 +1,11 @@
 """Every figure a chapter notebook shows, checked inside the kernel that runs the notebook.
 
-`figure_reports(path)` executes the notebook (nbclient, this interpreter's ipykernel) after a
-first cell that gives every figure and every explorer it displays one more output: the report
-of `report(fig)` as JSON (`coursekit.tools.site_figures.add_output`, the mechanism the website
-uses for its figures' descriptions). Returns one entry per displayed image: its cell, whether
-it carried a report, and the report.
+`PRELUDE`, run as a notebook's first cell, gives every figure and every explorer it displays one
+more output: the report of `figure_checks.figure_report(fig)` as JSON, under `REPORT`
+(`coursekit.tools.site_figures.add_output`, the mechanism the website uses for its figures'
+descriptions). tests/executed_chapters.py executes the chapters once with it; `figure_reports(nb)`
+reads an executed notebook whose first cell was the prelude: one entry per displayed image, its
+cell, and its report (None when it carried none).
 """
 
 from __future__ import annotations
@@ -12,33 +13,26 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-import nbformat
-
-from kernels import this_python_kernel
-
-__all__ = ["REPORT", "figure_reports"]
+__all__ = ["REPORT", "PRELUDE", "figure_reports"]
 
 #: the media type of the reports
 REPORT = "application/x-coursekit-figure-report+json"
 
-_PRELUDE = """\
+#: the first cell of a notebook whose figures are to be checked
+PRELUDE = f"""\
 import json as _json
 import sys as _sys
-_sys.path.insert(0, {tests!r})
+_sys.path.insert(0, {str(Path(__file__).parent)!r})
 import coursekit.tools.site_figures as _site_figures
 from figure_checks import figure_report as _figure_report
-_site_figures.add_output(get_ipython(), {mime!r}, lambda fig: _json.dumps(_figure_report(fig)), explorers=True)
+_site_figures.add_output(get_ipython(), {REPORT!r}, lambda fig: _json.dumps(_figure_report(fig)), explorers=True)
 """
 
 
-def figure_reports(path: Path) -> list[dict]:
-    """[{"cell": index in the notebook, "report": dict or None}] for each image the notebook shows."""
-    from nbclient import NotebookClient
-    nb = nbformat.read(path, as_version=4)
-    prelude = _PRELUDE.format(tests=str(Path(__file__).parent), mime=REPORT)
-    nb.cells.insert(0, nbformat.v4.new_code_cell(prelude))
-    NotebookClient(nb, km=this_python_kernel(), timeout=300,
-                   resources={"metadata": {"path": str(path.parent)}}).execute()
+def figure_reports(nb) -> list[dict]:
+    """[{"cell": index in the notebook without its prelude, "report": dict or None}] for each image
+    the executed notebook `nb` shows."""
+    assert PRELUDE in nb.cells[0].source, "the notebook did not run the figure checks' prelude first"
     out = []
     for index, cell in enumerate(nb.cells[1:]):
         for output in cell.get("outputs", []):

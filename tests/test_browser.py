@@ -201,11 +201,7 @@ def _first_explorer(page, selector: str, prop: str) -> str:
 def _check_accessibility(page, name: str) -> None:
     """axe-core finds no WCAG 2.1 AA violation inside the explorers; each figure has a text
     alternative that names its settings, and each slider and dropdown an accessible name."""
-    source = lab_h.axe_source()
-    if source is None:
-        pytest.fail("axe-core is not installed: npm install axe-core in the repository (or set "
-                    "AXE_CORE_JS to its axe.min.js); .ci/run installs it")
-    violations = lab_h.axe_violations(page, f"{lab_h.ACTIVE} .ck-explorer", source)
+    violations = lab_h.axe_violations(page, f"{lab_h.ACTIVE} .ck-explorer", lab_h.axe_source())
     assert not violations, f"{name}: accessibility violations in the explorers:\n" + "\n".join(violations)
     alts = page.evaluate(f"() => Array.from(document.querySelectorAll('{lab_h.ACTIVE} .ck-explorer img'))"
                          ".map(i => i.alt)")

@@ -4,7 +4,8 @@ The course's colours and line styles (`coursekit.style`), the checks of `figure_
 colours, curves told apart by line style or marker and not by colour alone, text contrast of
 4.5:1) shown to catch a figure made the old way, then applied to every figure the course makes:
 each plotting helper and every explorer (here), and every figure and explorer the chapter
-notebooks show (inside the kernel that runs each notebook, `notebook_figures`), where the layout
+notebooks show (inside the kernel that runs each notebook, `notebook_figures`; the notebooks
+executed once per test session, tests/executed_chapters.py), where the layout
 is checked too, as JupyterLab shows the figure and as the website draws it for its column. Last,
 the explorer's own text colours (its CSS) against JupyterLab's light and dark themes.
 """
@@ -149,8 +150,8 @@ def test_explorer_figure_is_readable_by_everyone_over_its_slider_range(name):
 
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
-def test_every_figure_a_notebook_shows_is_readable_by_everyone(path):
-    reports = figure_reports(path)
+def test_every_figure_a_notebook_shows_is_readable_by_everyone(path, executed_chapters):
+    reports = figure_reports(executed_chapters("instructor").notebook(path.name))
     assert reports, "the notebook shows no figure: every chapter has explorers and figures"
     missing = [r["cell"] for r in reports if r["report"] is None]
     assert not missing, f"images of cells {missing} were not checked (not a figure or explorer?)"

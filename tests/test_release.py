@@ -1,13 +1,11 @@
 """The student edition: built from the real notebooks, executed, and checked cell by cell.
 
-The release of the four notebooks is built once into a temporary folder and
-executed once (the four kernels run side by side); the tests below then read
-the built files and the executed notebooks. The unit tests at the end use
-small notebooks made here, with both kinds of solution cell (markdown
-``<details>`` and code).
+The release of the four notebooks is built once into a temporary folder and executed once per
+test session (the session fixture ``executed_chapters``, tests/executed_chapters.py); the tests
+below then read the built files and the executed notebooks. The unit tests at the end use small
+notebooks made here, with both kinds of solution cell (markdown ``<details>`` and code).
 """
 
-import asyncio
 import base64
 import re
 from pathlib import Path
@@ -23,26 +21,11 @@ from coursekit.tools.release import (STUDENT_NOTE, build_release, default_notebo
 NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))
 
 
-def _execute_all(paths, cwd):
-    """Execute the notebooks at `paths` side by side in kernels of this environment; return them."""
-    from nbclient import NotebookClient
-    notebooks = [read_notebook(path) for path in paths]
-    # store_widget_state=False as in the README's slides and HTML recipes: explorers keep their PNG
-    clients = [NotebookClient(nb, timeout=600, kernel_name="python3", store_widget_state=False,
-                              resources={"metadata": {"path": str(cwd)}}) for nb in notebooks]
-
-    async def run():
-        await asyncio.gather(*(client.async_execute() for client in clients))
-    asyncio.run(run())
-    return notebooks
-
-
 @pytest.fixture(scope="module")
-def release(tmp_path_factory):
-    out = tmp_path_factory.mktemp("student") / "edition"
-    paths = build_release(out)
-    return {"paths": paths, "stored": [read_notebook(p) for p in paths],
-            "executed": _execute_all(paths, out)}
+def release(executed_chapters):
+    student = executed_chapters("student")
+    return {"paths": student.paths, "stored": [read_notebook(p) for p in student.paths],
+            "executed": student.notebooks}
 
 
 def _has_tag(cell, tag):

@@ -31,6 +31,8 @@ from coursekit.tools.site import ALT, WIDGET_VIEW
 from coursekit.tools.slides import apply_slide_metadata, slide_types, with_slide_metadata
 
 import lab_harness  # the browser tests' Chromium location, settings and axe-core
+from executed_chapters import replay_into
+from notebook_figures import REPORT
 
 NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))
 
@@ -276,15 +278,26 @@ def _expected_slides(path: Path) -> tuple[int, int]:
 
 
 @pytest.fixture(scope="module")
-def course(tmp_path_factory):
-    """The slides of the whole course, built once with the command an instructor types."""
+def course(tmp_path_factory, executed_chapters):
+    """The slides of the whole course, built once with the command an instructor types; the
+    notebooks it would execute get the outputs of the session's executed instructor edition
+    (tests/executed_chapters.py: the same notebooks, run after the same first cell and the figure
+    checks'), which they must match cell by cell."""
     reason = lab_harness.missing_reason()
     if reason:
         pytest.skip(reason)
     _skip_without_slide_tools()
+    shared = executed_chapters("instructor")
+
+    async def replayed(notebooks, sources, **_):
+        for nb, path in zip(notebooks, sources):
+            replay_into(nb, shared.notebook(path.name), drop=(REPORT,))
+
     out = tmp_path_factory.mktemp("slides") / "slides"
     start = time.monotonic()
-    assert main(["slides", "--out", str(out)]) == 0
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(slideshow, "_execute_all", replayed)
+        assert main(["slides", "--out", str(out)]) == 0
     print(f"\nslides of {len(CHAPTERS)} chapters built in {time.monotonic() - start:.0f} s")
     return out
 
@@ -333,9 +346,7 @@ class Opened:
         assert self.errors == [], f"console errors: {self.errors}"
 
     def axe(self, selector: str) -> list[str]:
-        source = lab_harness.axe_source()
-        assert source, "axe-core is not installed: npm install axe-core (or set AXE_CORE_JS); .ci/run does it"
-        return lab_harness.axe_violations(self.page, selector, source)
+        return lab_harness.axe_violations(self.page, selector, lab_harness.axe_source())
 
 
 @pytest.fixture

@@ -1,0 +1,87 @@
+"""The test suite's markers (a pytest plugin that tests/conftest.py loads).
+
+* ``browser`` (set by the browser tests' modules): when Chromium or Playwright is missing, every
+  such test is skipped, and the run ends with one line that says why and how to get it;
+* ``notebooks`` (set here, on collection): the tests that execute notebooks in a Jupyter kernel,
+  nbval's cells of ``notebooks/`` and the tests `NOTEBOOK_TESTS` and `NOTEBOOK_FIXTURES` name;
+* ``sweeps`` (set here): the tests of `SWEEP_MODULES` run once for each explorer of the course
+  (parametrized over them), which move every slider over its range or drag it, in several styles;
+* ``slow`` (set here): any of the three. ``python -m pytest -m "not slow"`` is the contributors'
+  fast loop.
+"""
+
+from __future__ import annotations
+
+import pytest
+
+import lab_harness
+
+__all__ = ["NOTEBOOK_TESTS", "NOTEBOOK_FIXTURES", "SWEEP_MODULES", "browser_skip_line", "pytest_collection_modifyitems",
+           "pytest_collection_finish", "pytest_terminal_summary"]
+
+#: the tests that execute notebooks besides nbval's, as "module::test" (every parametrization)
+NOTEBOOK_TESTS = {
+    "test_figure_style.py::test_every_figure_a_notebook_shows_is_readable_by_everyone",
+    "test_site.py::test_small_build_instructor_site",
+    "test_site.py::test_small_build_student_site_has_no_solutions",
+    "test_site.py::test_the_site_builds_with_every_outside_connection_refused",
+    "test_slides.py::test_small_build_from_the_command_line_needs_no_network",
+}
+#: fixtures that execute notebooks (or hand out executed ones): every test using one is marked
+NOTEBOOK_FIXTURES = {"executed_chapters", "release", "graded", "extended"}
+
+#: the modules whose tests parametrized over the course's explorers are sweeps
+SWEEP_MODULES = {"test_explorer_frames.py", "test_figure_layout.py", "test_figure_style.py"}
+
+_BROWSER_SKIP = pytest.StashKey[tuple]()    # (reason, number of browser tests skipped)
+
+
+def _executes_notebooks(item) -> bool:
+    if item.path.suffix == ".ipynb":
+        return True
+    name = getattr(item, "originalname", item.name)
+    return (f"{item.path.name}::{name}" in NOTEBOOK_TESTS
+            or bool(NOTEBOOK_FIXTURES & set(getattr(item, "fixturenames", ()))))
+
+
+def _sweeps(item, explorers: list) -> bool:
+    """Whether `item` is a test of `SWEEP_MODULES` run for one of `explorers` (factory or name)."""
+    if item.path.name not in SWEEP_MODULES or not hasattr(item, "callspec"):
+        return False
+    names = {f.__name__ for f in explorers}
+    return any(any(value is f for f in explorers) or (isinstance(value, str) and value in names)
+               for value in item.callspec.params.values())
+
+
+@pytest.hookimpl(tryfirst=True)      # before -m deselects by these markers
+def pytest_collection_modifyitems(config, items):
+    """Mark the notebook tests, the sweeps and all slow tests."""
+    from coursekit.tools.chapters import explorer_factories
+    explorers = list(explorer_factories().values())
+    for item in items:
+        if _executes_notebooks(item):
+            item.add_marker(pytest.mark.notebooks)
+        if _sweeps(item, explorers):
+            item.add_marker(pytest.mark.sweeps)
+        if any(item.get_closest_marker(name) for name in ("notebooks", "sweeps", "browser")):
+            item.add_marker(pytest.mark.slow)
+
+
+def pytest_collection_finish(session):
+    """Skip the browser tests that are to run, saying why once, when no browser is here."""
+    browser = [item for item in session.items if item.get_closest_marker("browser")]
+    reason = lab_harness.missing_reason() if browser else None
+    if reason:
+        session.config.stash[_BROWSER_SKIP] = (reason, len(browser))
+        for item in browser:
+            item.add_marker(pytest.mark.skip(reason=reason))
+
+
+def browser_skip_line(reason: str, count: int) -> str:
+    """The one line that ends a run whose browser tests were skipped."""
+    return f"{count} browser tests skipped: {reason}"
+
+
+def pytest_terminal_summary(terminalreporter, exitstatus, config):
+    if _BROWSER_SKIP in config.stash:
+        terminalreporter.write_line(browser_skip_line(*config.stash[_BROWSER_SKIP]), yellow=True)
