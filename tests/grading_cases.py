@@ -3,10 +3,25 @@
 from __future__ import annotations
 
 import re
+import subprocess
 
 from nbformat.v4 import new_code_cell
 
-__all__ = ["SOLUTION", "exercise_section", "solved", "answer"]
+from coursekit.tools.grading.sandbox import find_bwrap
+
+__all__ = ["SOLUTION", "SANDBOX", "exercise_section", "solved", "answer"]
+
+
+def _bwrap_works() -> bool:
+    """Whether bubblewrap is installed and may make namespaces here."""
+    if find_bwrap() is None:
+        return False
+    return subprocess.run([find_bwrap(), "--unshare-all", "--ro-bind", "/", "/", "true"],
+                          capture_output=True).returncode == 0
+
+
+#: whether the grader's sandbox runs here (the README's install does not bring bubblewrap)
+SANDBOX = _bwrap_works()
 
 #: the code block a solution cell shows
 SOLUTION = re.compile(r"```python\n(?P<code>.*?)\n```", re.S)

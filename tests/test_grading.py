@@ -32,7 +32,7 @@ from coursekit.__main__ import main
 from coursekit.exercises._catalog import chapter_exercises
 from coursekit.tools.grading import grade, parse_memory
 from coursekit.tools.release import default_notebook_dir, read_notebook, student_edition
-from grading_cases import answer, exercise_section, solved
+from grading_cases import SANDBOX, answer, exercise_section, solved
 
 CHECKS = [entry.check for entry in chapter_exercises(1)]
 TIMEOUT = 20
@@ -76,13 +76,14 @@ def _submissions(folder: Path) -> None:
 
 @pytest.fixture(scope="module")
 def graded(tmp_path_factory):
-    """The submissions folder and the output of grading it twice (the second run is compared)."""
+    """The submissions folder and the output of grading it twice (the second run is compared);
+    in the sandbox where bubblewrap runs, else without (these notebooks harm nobody)."""
     folder = tmp_path_factory.mktemp("submissions")
     _submissions(folder)
     out, again = tmp_path_factory.mktemp("grades"), tmp_path_factory.mktemp("again")
-    grade(folder, out, chapter=1, timeout=TIMEOUT, memory="2G", jobs=2)
+    grade(folder, out, chapter=1, timeout=TIMEOUT, memory="2G", jobs=2, sandbox=SANDBOX)
     status = main(["grade", "--chapter", "1", str(folder), "--out", str(again), "--timeout", str(TIMEOUT),
-                   "--memory", "2G", "--jobs", "2"])
+                   "--memory", "2G", "--jobs", "2", *([] if SANDBOX else ["--no-sandbox"])])
     assert status == 0
     return folder, out, again
 
@@ -192,7 +193,7 @@ def test_help_names_the_sandbox_and_the_flag_that_goes_without(capsys):
 
 def test_an_empty_folder_still_writes_the_grade_book(tmp_path):
     (tmp_path / "subs").mkdir()
-    table = grade(tmp_path / "subs", tmp_path / "out", chapter=1, jobs=1)
+    table = grade(tmp_path / "subs", tmp_path / "out", chapter=1, jobs=1, sandbox=SANDBOX)
     assert table.read_text(encoding="utf-8").splitlines() == [",".join(["student", *CHECKS, "total", "status"])]
 
 

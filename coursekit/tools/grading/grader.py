@@ -208,11 +208,12 @@ def _run_notebook(nb, number: int, run: _Run, checks: list[str]) -> tuple[str, s
     private.mkdir()
     notebook = private / "submission.ipynb"
     nbformat.write(nb, notebook)
-    answers = box / "answers.jsonl"
+    answers, work = box / "answers.jsonl", box / "submission"
     answers.touch()
+    work.mkdir()
     if run.sandboxed:
         run.sandbox(box, answers).prepare()
-    job = {"notebook": str(notebook), "timeout": run.timeout, "memory": run.memory,
+    job = {"notebook": str(notebook), "cwd": str(work), "timeout": run.timeout, "memory": run.memory,
            "kernel_argv": run.kernel_argv(box, answers),
            "connection_file": str(box / "kernel.json") if run.sandboxed else None}
     env = {**os.environ, **({} if run.sandboxed else _kernel_env(answers))}

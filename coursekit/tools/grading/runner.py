@@ -1,8 +1,8 @@
 """Execute one submitted notebook for the grader, in a process of its own.
 
 ``python -m coursekit.tools.grading.runner JOB`` reads the job (JSON written by
-the grader: ``notebook``, ``kernel_argv``, ``timeout``, ``memory``,
-``connection_file``) and runs every cell of the notebook top to bottom in a
+the grader: ``notebook``, ``cwd`` (the kernel's working folder, when it is
+not sandboxed), ``kernel_argv``, ``timeout``, ``memory``, ``connection_file``) and runs every cell of the notebook top to bottom in a
 fresh kernel (nbclient) started with ``kernel_argv`` (the grader's limited
 kernel, `coursekit.tools.grading.kernel`, inside its sandbox,
 `coursekit.tools.grading.sandbox`). When ``connection_file`` is set, the kernel talks
@@ -115,7 +115,7 @@ def _client(nb, job: dict, kernels_dir: Path):
     km = AsyncKernelManager(kernel_name=KERNEL_NAME, kernel_spec_manager=KernelSpecManager(
         kernel_dirs=[str(kernels_dir)]), **options)
     return NotebookClient(nb, km=km, allow_errors=True, startup_timeout=120,
-                          resources={"metadata": {"path": str(Path(job["notebook"]).parent)}})
+                          resources={"metadata": {"path": job["cwd"]}})
 
 
 def _started(nb, job: dict, kernels_dir: Path, deadline: float):
