@@ -35,7 +35,7 @@ from coursekit.tools.release import default_notebook_dir, read_notebook, student
 from grading_cases import SANDBOX, answer, exercise_section, solved
 
 CHECKS = [entry.check for entry in chapter_exercises(1)]
-TIMEOUT = 20
+TIMEOUT = 45      # the whole student edition must finish well inside it on a busy machine
 
 
 def _submissions(folder: Path) -> None:
