@@ -104,16 +104,10 @@ def _write_settings(settings: Path) -> None:
         path.write_text(json.dumps(content))
 
 
-#: the settings a non-editable install of coursekit puts in share/jupyter/lab/settings/overrides.d
-COURSE_SETTINGS = Path(__file__).resolve().parents[1] / "jupyter-config" / "coursekit.json"
-
-
 @contextlib.contextmanager
-def running_lab(root: Path, base: Path, *, course_settings: bool = False):
+def running_lab(root: Path, base: Path):
     """Serve `root` with JupyterLab on a free loopback port; yields its URL. `base` (an empty
-    temporary folder) takes the settings, runtime files and the server log. With
-    `course_settings`, JupyterLab reads the course's default settings (`COURSE_SETTINGS`) from
-    its application settings' overrides.d, as where coursekit is installed."""
+    temporary folder) takes the settings, runtime files and the server log."""
     _write_settings(base / "settings")
     port = _free_port()
     cmd = [sys.executable, "-m", "jupyterlab", "--no-browser", "--ServerApp.open_browser=False",
@@ -121,10 +115,6 @@ def running_lab(root: Path, base: Path, *, course_settings: bool = False):
            f"--ServerApp.root_dir={root}", f"--IdentityProvider.token={TOKEN}",
            f"--LabApp.user_settings_dir={base / 'settings'}", f"--LabApp.workspaces_dir={base / 'workspaces'}",
            "--LabApp.expose_app_in_browser=True"]
-    if course_settings:
-        (base / "app-settings" / "overrides.d").mkdir(parents=True)
-        shutil.copy(COURSE_SETTINGS, base / "app-settings" / "overrides.d" / COURSE_SETTINGS.name)
-        cmd.append(f"--LabApp.app_settings_dir={base / 'app-settings'}")
     if hasattr(os, "geteuid") and os.geteuid() == 0:
         cmd.append("--allow-root")
     env = dict(os.environ, JUPYTER_CONFIG_DIR=str(base / "config"), JUPYTER_RUNTIME_DIR=str(base / "runtime"),

@@ -14,9 +14,7 @@ drawn whole again in the kernel for its final parameters); with a chapter
 open, the kernel does no work while nobody touches a control; and nothing anywhere reports an error (no
 traceback or stderr in a cell, no error or stderr message from the kernel,
 widget callbacks included, no uncaught error in the page). Nothing here
-asserts a time; ``python benchmarks/run.py --browser`` measures them. JupyterLab runs with the
-default settings a coursekit install gives it (`lab_harness.COURSE_SETTINGS`), and a notebook
-saved after Run All, closed and opened again shows its explorer as it was.
+asserts a time; ``python benchmarks/run.py --browser`` measures them.
 
 Needs Playwright for Python (``pip install playwright``, part of the dev extra)
 and the system Chromium (Debian package ``chromium``; no browser download).
@@ -102,8 +100,7 @@ def _chapter_notebooks() -> list[str]:
 
 @pytest.fixture(scope="module")
 def lab(tmp_path_factory):
-    """A JupyterLab server on a free loopback port serving copies of the notebooks, with the
-    settings a coursekit install gives JupyterLab."""
+    """A JupyterLab server on a free loopback port serving copies of the notebooks."""
     reason = lab_h.missing_reason()
     if reason:
         pytest.skip(reason)
@@ -115,8 +112,7 @@ def lab(tmp_path_factory):
     for name, (cells, _) in DRAG_NOTEBOOKS.items():
         lab_h.write_notebook(root / name, cells)
     lab_h.write_notebook(root / PLOTS_BESIDE_EXPLORER, [*DRAG_NOTEBOOKS["msd_explorer.ipynb"][0], _PLOT_CELL_CODE])
-    lab_h.write_notebook(root / REOPENED_NOTEBOOK, DRAG_NOTEBOOKS["msd_explorer.ipynb"][0])
-    with lab_h.running_lab(root, base, course_settings=True) as url:
+    with lab_h.running_lab(root, base) as url:
         yield url
 
 
@@ -421,44 +417,3 @@ def test_explorer_drawing_never_overlaps_other_kernel_work(page, opened):
         assert differ == 0, f"{name}: the figure shown is not the one for {reference['params']} ({differ} pixels differ)"
         errors = lab_h.error_outputs(page)
         assert not errors, "\n----\n".join(errors)
-
-
-# --- a notebook saved with its explorers and opened again ----------------------------------------
-
-REOPENED_NOTEBOOK = "reopened_explorer.ipynb"
-
-_SHOWN_EXPLORERS_JS = f"""() => Array.from(document.querySelectorAll('{lab_h.ACTIVE} .ck-explorer'))
-    .map(e => ({{alt: e.querySelector('img.ck-explorer-figure')?.alt || '',
-               width: e.querySelector('img.ck-explorer-figure')?.naturalWidth || 0,
-               readout: e.querySelector('.ck-readout')?.textContent || ''}}))"""
-
-
-def test_a_saved_notebook_shows_its_explorers_when_opened_again(lab, page, opened):
-    """Run All, save, close, stop the kernel, open again: the explorer shows its last figure, its
-    text alternative and its readout (not "Error displaying widget: model not found"); the
-    saved file holds the widget state, and the kernel metadata the notebook came with."""
-    with opened(REOPENED_NOTEBOOK):
-        _run_without_errors(page, REOPENED_NOTEBOOK)
-        lab_h.first_slider(page)
-        before = page.evaluate(_SHOWN_EXPLORERS_JS)
-        assert len(before) == 1 and "Settings:" in before[0]["alt"], before
-        lab_h.close_all(page)                           # saves the notebook
-        lab_h.shut_down_kernels(lab)
-        saved = _saved_metadata(lab, REOPENED_NOTEBOOK)
-        assert "application/vnd.jupyter.widget-state+json" in saved.get("widgets", {}), sorted(saved)
-        assert {k: saved[k] for k in ("kernelspec", "language_info")} == lab_h._kernel_metadata()
-        lab_h.open_notebook(page, REOPENED_NOTEBOOK)
-        page.wait_for_selector(f"{lab_h.ACTIVE} .ck-explorer img.ck-explorer-figure", timeout=60_000)
-        page.wait_for_timeout(1000)
-        after = page.evaluate(_SHOWN_EXPLORERS_JS)
-        errors = lab_h.error_outputs(page)
-    assert not errors, errors
-    assert after == before, (before, after)
-    assert after[0]["width"] > 0 and after[0]["readout"].strip()
-
-
-def _saved_metadata(url: str, name: str) -> dict:
-    """The metadata of the notebook `name` as the server has it on disk."""
-    import urllib.request
-    with urllib.request.urlopen(f"{url}/api/contents/{name}?content=1&token={lab_h.TOKEN}", timeout=30) as response:
-        return json.load(response)["content"]["metadata"]

@@ -21,9 +21,8 @@ def test_notebook_is_stored_clean(path):
     assert not dirty, (f"{path.name}: code cells {dirty} have stored outputs or execution counts; "
                        "clear them (Edit > Clear Outputs of All Cells) before committing")
     assert "widgets" not in nb.get("metadata", {}), (
-        f"{path.name}: widget state is stored in the notebook metadata (coursekit turns on saving it, "
-        "so that students' notebooks keep their explorers); clear it before committing: in JupyterLab "
-        "Settings > Save Widget State Automatically off, delete the notebook's 'widgets' metadata, save")
+        f"{path.name}: widget state is stored in the notebook metadata; "
+        "clear it (in JupyterLab: Settings > Save Widget State Automatically off, then save)")
 
 
 #: what Markdown reads as the start of a list, heading or quote when a line begins with it
