@@ -129,15 +129,24 @@ def plot_poles(poles, *, dt=None, ax=None, title: str | None = None):
     return fig, ax
 
 
+#: an imaginary part below this fraction of a pole's size is rounding noise (a repeated real pole,
+#: such as the double observer pole -s, -s, comes out of eig as -s ± 1e-8 s j)
+IMAG_NOISE = 1e-6
+_TIMES = {2: "double", 3: "triple"}
+
+
 def format_poles(poles, digits: int = 3) -> str:
     """Poles (any complex numbers) as short text, e.g. for an explorer's readout:
-    ``"-1, -0.5 ± 2j"``, sorted by real part; a conjugate pair is written once."""
+    ``"-1, -0.5 ± 2j"``, sorted by real part; a conjugate pair is written once, and poles that
+    read the same once rounded are written once with their multiplicity (``"-17 (double)"``),
+    an imaginary part smaller than `IMAG_NOISE` of the pole's size being rounding noise."""
     try:
         values = np.atleast_1d(np.asarray(poles, dtype=complex)).ravel()
     except (TypeError, ValueError):
         raise ValueError(f"poles must be a list of numbers: received {poles!r}.") from None
     if isinstance(poles, str) or not values.size or not np.all(np.isfinite(values)):
         raise ValueError(f"poles must be a non-empty list of finite numbers: received {poles!r}.")
+    values = np.where(np.abs(values.imag) <= IMAG_NOISE * np.abs(values), values.real, values)
     pending, out = sorted(values, key=lambda p: (p.real, -p.imag)), []
     while pending:
         p = pending.pop(0)
@@ -147,4 +156,14 @@ def format_poles(poles, digits: int = 3) -> str:
             pending.remove(pair)
         out.append(re if p.imag == 0 else f"{re} ± {im}" if pair is not None
                    else f"{re} {'+' if p.imag > 0 else '-'} {im}")
-    return ", ".join(out)
+    return ", ".join(_with_multiplicity(out))
+
+
+def _with_multiplicity(texts: list[str]) -> list[str]:
+    """Equal neighbouring texts once, with how many: ["-17", "-17"] -> ["-17 (double)"]."""
+    out: list[str] = []
+    for text in texts:
+        count = texts.count(text)
+        if text not in (o.split(" (")[0] for o in out):
+            out.append(text if count == 1 else f"{text} ({_TIMES.get(count, f'x {count}')})")
+    return out

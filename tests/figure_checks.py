@@ -8,6 +8,8 @@
   line counts by its colour; a straight unlabelled reference line, such as a zero line, does not
   count) must differ in line style or marker (two lines of one colour and look, one labelled and
   one not, are more of the same curve; two of different labels are told apart by nothing);
+* a curve that does not start where its label or its axes' title says it starts (`start_problems`:
+  "start 10 deg", "x0 = -2", "released from 2 rad", "x(0) = [1, 0]"), in sign and unit;
 * drawn text with less than 4.5:1 contrast (WCAG 2.1 1.4.3) against what it is drawn on: the
   legend's frame for legend text, a text's own box, the axes for text inside an axes, and the
   figure elsewhere, each painted over the layers below it and over a white page.
@@ -16,6 +18,7 @@
 from __future__ import annotations
 
 import itertools
+import re
 
 import numpy as np
 from matplotlib.colors import to_hex, to_rgba
@@ -24,7 +27,8 @@ from matplotlib.lines import Line2D
 import coursekit as ck
 from layout_check import drawn_texts
 
-__all__ = ["MIN_TEXT_CONTRAST", "COVERED", "style_problems", "figure_report", "colour_problems", "curve_problems", "contrast_problems"]
+__all__ = ["MIN_TEXT_CONTRAST", "COVERED", "style_problems", "figure_report", "colour_problems", "curve_problems", "contrast_problems",
+           "start_problems"]
 
 #: WCAG 2.1 AA for text (1.4.3)
 MIN_TEXT_CONTRAST = 4.5
@@ -108,6 +112,71 @@ def curve_problems(fig) -> list[str]:
     return problems
 
 
+#: a start stated in a curve's label: "start 10 deg", "x0 = -2", "nonlinear pendulum, 0.6 rad"
+_LABEL_START = re.compile(r"(?:\bstart\s+|\bx0 = )(-?\d+(?:\.\d+)?)(?:\s*(deg|rad)\b)?|, (-?\d+(?:\.\d+)?) (deg|rad)$")
+#: a start stated in a title: "released from 2 rad"; "x(0) = [1, 0, 0]"
+_TITLE_FROM = re.compile(r"\bfrom (-?\d+(?:\.\d+)?) (deg|rad)\b")
+_TITLE_VECTOR = re.compile(r"\bx\(0\) = \[([-\d., ]+)\]")
+
+
+def _curves(ax) -> list:
+    """The curves of `ax` that can have a start: neither a point nor a straight level line (axhline)."""
+    def level(line):
+        xs, ys = (np.asarray(v, dtype=float) for v in line.get_data())
+        return xs.size == 2 and (np.ptp(xs) == 0 or np.ptp(ys) == 0)
+    return [line for line in ax.get_lines() if line.get_visible() and np.size(line.get_xdata()) > 1
+            and not level(line)]
+
+
+def _first(line) -> tuple[float, float]:
+    x, y = (np.asarray(v, dtype=float) for v in line.get_data())
+    return float(x[0]), float(y[0])
+
+
+def _unit_ok(ax, unit) -> bool:
+    """A stated unit is the unit of the axes' vertical axis (no unit stated: any)."""
+    return unit is None or f"[{unit}]" in ax.get_ylabel()
+
+
+def _stated(pattern, text: str) -> tuple[float, str | None] | None:
+    """(value, unit or None) of the first start `pattern` finds in `text`, or None."""
+    found = pattern.search(text)
+    if not found:
+        return None
+    value, unit = (found.groups() + (None,))[:2] if found.group(1) is not None else found.groups()[2:4]
+    return float(value), unit
+
+
+def _stated_starts(ax) -> dict:
+    """{curve: (x0 or None, y0)}: the starts the curves' labels or the axes' title state."""
+    curves, stated = _curves(ax), {}
+    for line in curves:
+        found = _stated(_LABEL_START, line.get_label()) or _stated(_TITLE_FROM, ax.get_title())
+        if found and _first(line)[0] == 0 and _unit_ok(ax, found[1]):
+            stated[line] = (None, found[0])
+    vector = _TITLE_VECTOR.search(ax.get_title())
+    if vector and not stated:
+        values = [float(v) for v in vector.group(1).split(",")]
+        if len(curves) == 1 and _first(curves[0])[0] != 0:          # a state plane: the point x(0)
+            stated[curves[0]] = tuple(values[:2])
+        elif len(curves) == len(values):                              # one curve per state
+            stated.update({line: (None, v) for line, v in zip(curves, values)})
+    return stated
+
+
+def start_problems(fig) -> list[str]:
+    """Curves of a time response (from t = 0) that do not start at the value their label or
+    their axes' title states, and a state-plane curve that does not start at the stated x(0)."""
+    problems = []
+    for i, ax in enumerate(fig.axes):
+        for line, (x0, y0) in _stated_starts(ax).items():
+            x, y = _first(line)
+            if not np.isclose(y, y0, atol=1e-6) or (x0 is not None and not np.isclose(x, x0, atol=1e-6)):
+                shown, said = ((f"{y:g}", f"{y0:g}") if x0 is None else (f"({x:g}, {y:g})", f"({x0:g}, {y0:g})"))
+                problems.append(f"{_identity(line)!r} of {_where(ax, i)} starts at {shown}, its text states {said}")
+    return problems
+
+
 def _paint(colour, below) -> tuple:
     """`colour` with its alpha painted over the opaque colour `below`: an opaque RGB."""
     *rgb, alpha = to_rgba(colour)
@@ -161,7 +230,8 @@ def contrast_problems(fig) -> list[str]:
 
 
 def figure_report(fig) -> dict:
-    """Problems of `fig` by kind: ``style`` (`style_problems`), ``layout`` (text outside the figure
+    """Problems of `fig` by kind: ``style`` (`style_problems`), ``start`` (`start_problems`),
+    ``layout`` (text outside the figure
     or on other text, legends hiding curves: `layout_check`) and ``site layout`` (the same, with
     the figure drawn for the website's column: `coursekit.tools.site_figures`)."""
     from coursekit.tools.site_figures import drawn_for_the_column
@@ -169,7 +239,7 @@ def figure_report(fig) -> dict:
 
     def layout():
         return text_problems(fig) + legend_problems(fig, covered=COVERED)
-    report = {"style": style_problems(fig), "layout": layout()}
+    report = {"style": style_problems(fig), "layout": layout(), "start": start_problems(fig)}
     with drawn_for_the_column(fig) as zoom:
         report["site layout"] = [f"{problem} (drawn {zoom:.2f} times larger)" for problem in layout()]
     return report

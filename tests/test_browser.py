@@ -14,7 +14,9 @@ drawn whole again in the kernel for its final parameters); with a chapter
 open, the kernel does no work while nobody touches a control; and nothing anywhere reports an error (no
 traceback or stderr in a cell, no error or stderr message from the kernel,
 widget callbacks included, no uncaught error in the page). Nothing here
-asserts a time; ``python benchmarks/run.py --browser`` measures them.
+asserts a time; ``python benchmarks/run.py --browser`` measures them. In Notebook 7 (served by
+the same server), arrow keys, Home and End on a focused slider step it and leave the notebook's
+cell selection alone.
 
 Needs Playwright for Python (``pip install playwright``, part of the dev extra)
 and the system Chromium (Debian package ``chromium``; no browser download).
@@ -32,6 +34,7 @@ import shutil
 import time
 from pathlib import Path
 
+import nbformat
 import numpy as np
 import pytest
 
@@ -112,6 +115,7 @@ def lab(tmp_path_factory):
     for name, (cells, _) in DRAG_NOTEBOOKS.items():
         lab_h.write_notebook(root / name, cells)
     lab_h.write_notebook(root / PLOTS_BESIDE_EXPLORER, [*DRAG_NOTEBOOKS["msd_explorer.ipynb"][0], _PLOT_CELL_CODE])
+    lab_h.write_notebook(root / KEYS_NOTEBOOK, KEYS_CELLS)
     with lab_h.running_lab(root, base) as url:
         yield url
 
@@ -413,3 +417,57 @@ def test_explorer_drawing_never_overlaps_other_kernel_work(page, opened):
         assert differ == 0, f"{name}: the figure shown is not the one for {reference['params']} ({differ} pixels differ)"
         errors = lab_h.error_outputs(page)
         assert not errors, "\n----\n".join(errors)
+
+
+# --- keys on an explorer's controls, in Notebook 7 ---------------------------------------------
+
+KEYS_NOTEBOOK = "keys_explorer.ipynb"
+# a section heading above the explorer (ArrowLeft collapses it in command mode) and a cell below
+# it (ArrowDown selects it)
+KEYS_CELLS = [nbformat.v4.new_markdown_cell("# A section"), "\n".join(DEMO_SOURCE),
+              nbformat.v4.new_markdown_cell("# The next section"), "1 + 1"]
+
+_CELLS_JS = """() => {
+    const cells = Array.from(document.querySelectorAll('.jp-Notebook .jp-Cell'));
+    return {active: cells.findIndex(c => c.classList.contains('jp-mod-active')),
+            shown: cells.filter(c => c.offsetParent !== null).length,
+            focused: document.activeElement?.getAttribute('role') || ''};
+}"""
+
+
+def test_keys_on_a_focused_slider_step_it_and_never_reach_notebook_7_s_shortcuts(lab, page):
+    """Arrow keys, Home and End on a focused explorer slider move the slider in Notebook 7, where
+    in command mode they are shortcuts (the next cell, collapse or expand the section)."""
+    pytest.importorskip("notebook", minversion="7", reason="Notebook 7 is not installed")
+    tab = page.context.browser.new_page(viewport=lab_h.VIEWPORT)
+    try:
+        tab.goto(f"{lab}/notebooks/{KEYS_NOTEBOOK}?token={lab_h.TOKEN}")
+        tab.wait_for_selector(".jp-Notebook .jp-Cell", timeout=90_000)
+        tab.wait_for_function("() => document.querySelector('.jp-Notebook-ExecutionIndicator')?.dataset.status"
+                              " === 'idle'", timeout=90_000)
+        # a dialog Notebook 7 may show while it connects the kernel goes by itself
+        tab.wait_for_function("() => !document.querySelector('.jp-Dialog')", timeout=60_000)
+        handle = tab.locator(".ck-explorer .noUi-handle").first
+        for _ in range(3):                     # Run > Run All Cells; again when clicked too early
+            tab.locator(".lm-MenuBar-itemLabel", has_text="Run").first.click()
+            tab.locator(".lm-Menu-item:visible", has_text="Run All Cells").first.click()
+            try:
+                handle.wait_for(timeout=60_000)
+                break
+            except Exception:  # playwright's TimeoutError: nothing ran
+                tab.keyboard.press("Escape")
+        readout = tab.locator(".ck-explorer .widget-slider .widget-readout").first
+        tab.wait_for_timeout(1000)
+        handle.focus()
+        before = tab.evaluate(_CELLS_JS)
+        assert before["focused"] == "slider", before
+        seen = []
+        for key, value in [("ArrowRight", 1.1), ("ArrowUp", 1.2), ("ArrowLeft", 1.1), ("ArrowDown", 1.0),
+                           ("End", 3.0), ("Home", 0.1)]:
+            handle.press(key)
+            tab.wait_for_timeout(300)
+            seen.append((key, float(readout.inner_text().strip().replace("\u2212", "-")), tab.evaluate(_CELLS_JS)))
+            assert seen[-1][1:] == (pytest.approx(value), before), seen
+    finally:
+        tab.close()
+        lab_h.shut_down_kernels(lab)

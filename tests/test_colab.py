@@ -54,7 +54,16 @@ def test_install_cell_installs_from_the_repository_where_coursekit_is_missing():
 def test_install_cell_without_repository_says_what_to_do():
     result = _run(install_cell_source(None), hide_coursekit=True)
     assert result.returncode != 0
-    assert 'ModuleNotFoundError: coursekit is missing: run %pip install "coursekit @ git+' in result.stderr
+    assert "ModuleNotFoundError: coursekit is missing: install it from the course repository" in result.stderr
+
+
+def test_an_install_cell_without_repository_shows_no_install_line():
+    """No stand-in address (OWNER/NAME) a reader would copy: an install line only with a real address."""
+    source = install_cell_source(None)
+    assert "OWNER" not in source and "git+" not in source and "pip install" not in source
+    for path in NOTEBOOKS:
+        first_code = next(c for c in read_notebook(path).cells if c.cell_type == "code")
+        assert "OWNER/NAME" not in first_code.source, path.name
 
 
 @pytest.mark.parametrize("bad", ["github.com/a/b", "http://github.com/a/b", "https://github.com/a b", 3])

@@ -30,10 +30,10 @@ def test_pole_placement_compute_places_the_poles(wn, zeta, p3):
 def test_upright_pendulum_compute_both_controllers():
     r = ch3.upright_pendulum_compute(theta0_deg=30.0)
     assert r["linear_ok"] and r["fl_ok"]
-    assert r["dev_linear"][0] == pytest.approx(-30.0)
-    # the feedback-linearized loop is exactly linear: e'' = -6 e - 5 e' from e(0) = -30 deg
+    assert r["dev_linear"][0] == pytest.approx(30.0)          # theta - pi starts at the slider's angle
+    # the feedback-linearized loop is exactly linear: e'' = -6 e - 5 e' from e(0) = 30 deg
     t = r["t"]
-    exact = -30.0 * (3 * np.exp(-2 * t) - 2 * np.exp(-3 * t))
+    exact = 30.0 * (3 * np.exp(-2 * t) - 2 * np.exp(-3 * t))
     np.testing.assert_allclose(r["dev_fl"], exact, atol=1e-4)
     # a tight torque limit loses the pendulum from 120 degrees
     r = ch3.upright_pendulum_compute(theta0_deg=120.0, u_max=3.0)
@@ -97,4 +97,4 @@ def test_the_pendulum_started_upright_is_drawn_flat_not_its_numerical_noise():
     e.controls["theta0_deg"].value = 30.0                         # a real response keeps its scale
     e.refresh()
     low, high = e.handles["ax_th"].get_ylim()
-    assert low <= -30.0 and high - low < 60.0 + 30.0
+    assert high >= 30.0 and high - low < 60.0 + 30.0

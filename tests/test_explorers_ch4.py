@@ -57,3 +57,16 @@ def test_explorers_build_without_a_browser():
         e = make()
         assert e.result is not None and e.png.startswith(b"\x89PNG")
         assert e.fig.axes[0].get_title()
+
+
+def test_the_observer_readout_shows_its_double_pole_as_one_real_pole_over_the_slider():
+    """Both observer poles sit at -s: the readout says "-s (double)", never eig's rounding noise
+    ("-17 ± 2.38e-07j")."""
+    explorer = observer_noise_explorer()
+    slider = explorer.controls["speed"]
+    for speed in np.arange(slider.min, slider.max + slider.step / 2, slider.step):
+        slider.value = float(round(speed, 6))
+        explorer.refresh()
+        shown = explorer.text.split(",")[0]
+        assert shown == f"observer poles {-slider.value:.3g} (double)", shown
+        assert "j" not in explorer.alt.split("L =")[0]

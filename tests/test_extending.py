@@ -92,3 +92,21 @@ def test_the_checks_every_chapter_must_pass_pass_for_the_new_chapter(extended, a
     result = _run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *args], extended, timeout=900)
     assert result.returncode == 0, result.stdout[-5000:]
     assert re.search(r"\b\d+ passed", result.stdout), result.stdout[-2000:]
+
+
+def test_the_checks_the_doc_runs_say_which_extra_they_need():
+    text = DOC.read_text(encoding="utf-8")
+    before = text[:text.index("python -m pytest notebooks/05_lag.ipynb")]
+    assert '".[dev]"' in before.rsplit("```", 2)[-2], "say that pytest and the test tools come with the dev extra"
+
+
+def test_the_release_command_of_the_doc_runs_after_the_instructors_guide_s(extended):
+    """The instructors' guide writes build/student first; the doc's command replaces that edition."""
+    guide = (ROOT / "docs" / "instructors.md").read_text(encoding="utf-8")
+    first = re.search(r"^python -m coursekit release --out build/student$", guide, re.M)
+    assert first, "docs/instructors.md no longer writes build/student"
+    again = re.search(r"`python -m coursekit (release --out build/student[^`]*)`", DOC.read_text(encoding="utf-8"))
+    for command in (first.group(0).split()[3:], again.group(1).split()):
+        result = _run([sys.executable, "-m", "coursekit", *command], extended, timeout=300)
+        assert result.returncode == 0, result.stderr[-2000:]
+    assert len(list((extended / "build" / "student").glob("0*.ipynb"))) == 5

@@ -62,13 +62,66 @@ def test_the_catalog_is_the_notebook_exercises_in_order(path):
 
 def test_states_follow_the_last_answer():
     assert set(_states(1).values()) == {NOT_TRIED}
-    _quiet(ex.check_msd_state_space, None, None, None)
-    assert _states(1)["check_msd_state_space"] == NOT_YET
+    _quiet(ex.check_msd_state_space, None, None, None)               # the untouched placeholders
+    assert _states(1)["check_msd_state_space"] == NOT_TRIED
     _quiet(ex.check_msd_state_space, *MSD_RIGHT)
     assert _states(1)["check_msd_state_space"] == CORRECT
-    _quiet(ex.check_msd_state_space, [[1]], None, None)
+    _quiet(ex.check_msd_state_space, None, None, None)               # no answer: the last one stays
+    assert _states(1)["check_msd_state_space"] == CORRECT
+    _quiet(ex.check_msd_state_space, [[1]], None, None)              # partly filled in: an answer
     assert _states(1)["check_msd_state_space"] == NOT_YET
     assert list(_states(1).values()).count(NOT_TRIED) == 4
+
+
+def _answer_cells(path):
+    cells = json.loads(path.read_text(encoding="utf-8"))["cells"]
+    return ["".join(c["source"]) for c in cells if c["cell_type"] == "code"
+            and c["metadata"].get("coursekit") == "exercise" and re.search(r"ex\.check_\w+\(", "".join(c["source"]))]
+
+
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=lambda p: p.name)
+def test_run_all_on_a_fresh_chapter_leaves_every_exercise_not_tried_and_unanswered(path, tmp_path, monkeypatch):
+    """Run All calls each check with its placeholders: the check says what to do, and the
+    exercise stays "not tried" in the progress overview and unanswered in the grader's file."""
+    answers = tmp_path / "answers.jsonl"
+    monkeypatch.setenv(ANSWERS_ENV, str(answers))
+    cells = _answer_cells(path)
+    assert len(cells) == len(CATALOG[int(path.name[:2])])
+    for source in cells:
+        with contextlib.redirect_stdout(io.StringIO()) as printed:
+            exec(source, {"ex": ex, "display": lambda *objects: None})      # as the notebook runs it
+        assert printed.getvalue().startswith("Not yet"), printed.getvalue()
+    shown = ex.progress(int(path.name[:2]))
+    assert set(_states(int(path.name[:2])).values()) == {NOT_TRIED}, repr(shown)
+    assert shown.summary().endswith(f"0 of {len(cells)} exercises correct, 0 not yet, {len(cells)} not tried")
+    assert not answers.exists() or read_records(answers) == []
+
+
+@pytest.mark.parametrize("placeholder", [None, ..., [None, None, None, None], (None,)])
+def test_a_placeholder_is_no_answer(placeholder, tmp_path, monkeypatch):
+    monkeypatch.setenv(ANSWERS_ENV, str(tmp_path / "answers.jsonl"))
+    result, printed = _quiet(ex.check_stability, placeholder)
+    assert not result and printed.startswith("Not yet")
+    assert _states(3)["check_stability"] == NOT_TRIED
+    assert not (tmp_path / "answers.jsonl").exists()
+
+
+def _untouched(x, u):
+    return None   # [theta', theta'']
+
+
+def _forgot_the_return(x, u):
+    x[1] + u[0]
+
+
+def test_an_untouched_function_is_no_answer_but_one_with_a_body_is(tmp_path, monkeypatch):
+    monkeypatch.setenv(ANSWERS_ENV, str(tmp_path / "answers.jsonl"))
+    _quiet(ex.check_pendulum_f, _untouched)
+    assert _states(1)["check_pendulum_f"] == NOT_TRIED and not (tmp_path / "answers.jsonl").exists()
+    result, printed = _quiet(ex.check_pendulum_f, _forgot_the_return)
+    assert not result and "return" in printed
+    assert _states(1)["check_pendulum_f"] == NOT_YET
+    assert [r["check"] for r in read_records(tmp_path / "answers.jsonl")] == ["check_pendulum_f"]
 
 
 def test_a_replaced_check_changes_nothing(monkeypatch):

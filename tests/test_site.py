@@ -284,6 +284,9 @@ def test_small_build_instructor_site(tmp_path):
     assert link, "no download link to the chapter's notebook"
     downloaded = nbformat.read(out / link.group(1), as_version=4)
     assert not any(c.get("outputs") for c in downloaded.cells if c.cell_type == "code")
+    # the notebook to download is no page of the site: no orphan copy, none in the search index
+    assert not (out / "downloads").exists(), sorted(p.name for p in (out / "downloads").iterdir())
+    assert "downloads/" not in (out / "searchindex.js").read_text(encoding="utf-8")
 
 
 def test_small_build_student_site_has_no_solutions(tmp_path):

@@ -65,6 +65,10 @@ def test_plot_poles_shades_and_labels():
     ([1j], "0 + 1j"),
     ([-2 - 1j], "-2 - 1j"),
     (np.array([-1.23456]), "-1.23"),
+    ([-17 + 2.38e-7j, -17 - 2.38e-7j], "-17 (double)"),      # a double pole as eig returns it
+    ([-2.79999996, -2.80000004], "-2.8 (double)"),
+    ([-1, -1, -1, -4], "-4, -1 (triple)"),
+    ([-1 + 1e-3j, -1 - 1e-3j], "-1 ± 0.001j"),                # a slow oscillation, not noise
 ])
 def test_format_poles_writes_a_conjugate_pair_once(poles, text):
     assert ck.format_poles(poles) == text

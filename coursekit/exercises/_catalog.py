@@ -15,6 +15,12 @@ that every call
 * keeps the verdict for this session in `STATE` (read by
   `coursekit.exercises.progress`): the last answer counts.
 
+A call with the exercise's untouched placeholder (every argument ``None``, a list of ``None``
+such as ``[None, None, None, None]``, or a function whose body only returns None, as the
+notebook's answer cells hold them before a student types anything) is not an answer: the check
+still prints what to do, but the call is neither recorded nor kept, so Run All on a fresh
+chapter leaves its exercises "not tried" in `progress` and unanswered for the grader.
+
 The wrapped function keeps the check's name, docstring and signature
 (`functools.wraps`); the course's own check is its ``__wrapped__``, which the
 grader calls. A check the student replaces in the notebook records nothing.
@@ -70,6 +76,8 @@ def _wrap(check: Callable) -> Callable:
             bound = signature.bind(*args, **kwargs)
         except TypeError:
             return check(*args, **kwargs)          # raises the same TypeError for the student
+        if bound.arguments and all(map(_placeholder, bound.arguments.values())):
+            return check(*args, **kwargs)          # not tried yet: its feedback, no answer kept
         tapes = {k: Tape(v) for k, v in bound.arguments.items() if callable(v) and not _is_data(v)}
         if not tapes:
             _record(check.__name__, bound, {})
@@ -82,6 +90,23 @@ def _wrap(check: Callable) -> Callable:
         return result
 
     return recorded
+
+
+def _returns_none():
+    return None      # the body of an answer cell's untouched function
+
+
+def _placeholder(value) -> bool:
+    """True for an answer cell's untouched placeholder: None (or ``...``), a non-empty list or
+    tuple of placeholders, or a function whose code only returns None (``return None``, ``pass``)."""
+    if value is None or value is Ellipsis:
+        return True
+    if isinstance(value, (list, tuple)):
+        return bool(value) and all(map(_placeholder, value))
+    if not inspect.isfunction(value):
+        return False
+    code, nothing = value.__code__, _returns_none.__code__
+    return code.co_code == nothing.co_code and code.co_consts == nothing.co_consts and not code.co_names
 
 
 def _is_data(value) -> bool:

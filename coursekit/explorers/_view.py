@@ -4,7 +4,8 @@
 PNG as an ``<img>`` at the PNG's pixel size over the device pixel ratio (never scaled), and
 reports the pixel ratio and the room the figure has when shown and when that room changes; it
 asks for nothing else, so while nobody touches a control the kernel does no work. The image
-carries the text alternative; a polite live region announces it once a control has rested.
+carries the text alternative; a polite live region announces it once a control has rested. The
+explorer's controls keep the keys pressed on them from the notebook's shortcuts.
 """
 
 from __future__ import annotations
@@ -66,8 +67,11 @@ function render({ model, el }) {
     }
   }
   function schedule() { if (pending === null) pending = setTimeout(report, 150); }
-  // a slider's handle gets its label as its accessible name (ipywidgets leaves it unnamed);
-  // the explorer is found once the view is in the page
+  // a slider's handle gets its label as its accessible name (ipywidgets leaves it unnamed), and
+  // every control keeps its keys: JupyterLab and Notebook 7 (Lumino) match no shortcut for a key
+  // pressed on an element marked data-lm-suppress-shortcuts, so an arrow key steps the slider
+  // instead of selecting the next cell or collapsing the section; the explorer is found once
+  // the view is in the page
   let explorer = null;
   function nameControls() {
     if (!explorer && (explorer = el.closest(".ck-explorer"))) {
@@ -77,6 +81,12 @@ function render({ model, el }) {
       const handle = control.querySelector('[role="slider"]:not([aria-label])');
       const label = control.querySelector(".widget-label")?.textContent.trim();
       if (handle && label) handle.setAttribute("aria-label", label);
+    }
+    const keyed = '.ck-controls [role="slider"], .ck-controls select, .ck-controls input';
+    for (const control of explorer?.querySelectorAll(keyed) || []) {
+      if (!control.hasAttribute("data-lm-suppress-shortcuts")) {
+        control.setAttribute("data-lm-suppress-shortcuts", "true");
+      }
     }
   }
   const named = new MutationObserver(nameControls);

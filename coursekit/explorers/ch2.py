@@ -89,7 +89,7 @@ def planner_explorer() -> Explorer:
         for line in h["marks"]:
             line.set_xdata([r["T"], r["T"]])
         rescale(h["ax_y"], h["ax_u"])
-        rescale(h["ax_u"], axis="x")          # the shared time axis [0, 2 T], from 0 on
+        rescale(h["ax_u"], axis="x", fill=1.0)   # the shared time axis: [0, 2 T] once the controls rest
 
     def readout(r):
         return (f"degree {2 * r['r'] - 1} move to {r['target']:g} m in T = {r['T']:g} s, "

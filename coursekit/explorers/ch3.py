@@ -161,8 +161,9 @@ def upright_pendulum_compute(theta0_deg: float = 30.0, pole: float = -2.0, u_max
     law u = K (x - x*) + u* (3.92) with K from the linearization (3.74),
     and the feedback-linearizing law (3.154) measured from theta = pi. Both
     torques are clipped to |u| <= `u_max` [N m] (a motor limit; the notes
-    have none). Start: `theta0_deg` away from upright, at rest. Returns
-    ``t``, the deviations from upright ``dev_linear`` and ``dev_fl`` [deg],
+    have none). Start: theta = pi + `theta0_deg` (in degrees), at rest, so the
+    deviations from upright ``dev_linear`` and ``dev_fl`` = theta - pi [deg] start at
+    `theta0_deg`, in its sign. Returns ``t``, the deviations,
     the torques ``u_linear`` and ``u_fl`` [N m], ``K`` and booleans
     ``linear_ok`` / ``fl_ok`` (ends within 1 degree of upright, any turn).
     """
@@ -186,7 +187,7 @@ def upright_pendulum_compute(theta0_deg: float = 30.0, pole: float = -2.0, u_max
         # both loops in one stacked ODE: column j of X is driven by controller j
         return np.column_stack([law(tk, X[:, j]) for j, law in enumerate(laws)])
 
-    x0 = [np.pi - theta0, 0.0]
+    x0 = [np.pi + theta0, 0.0]             # theta - pi = theta0: the slider's angle, its sign
     X = simulate_batch(P, t, [x0, x0], u=u_batch, rtol=1e-6, atol=1e-8)
     for j, (name, law) in enumerate(zip(controllers, laws)):
         x = X[:, j]

@@ -8,8 +8,9 @@ nothing where coursekit is installed (your own JupyterLab, Binder, CI).
 A notebook knows nothing of the repository it was opened from, so the
 repository's address has to be written into the cell: ``python -m coursekit
 colab`` writes the address of the git remote ``origin`` (or the one given with
-``--repository``) into the cell of every notebook. Until that is done, the cell
-stops on Colab with the ``%pip install`` line to run by hand.
+``--repository``) into the cell of every notebook. Until that is done, the cell names no
+address (an install line with a stand-in such as OWNER/NAME would be copied as it stands): it
+stops on Colab saying that coursekit is missing and where to find how to install it.
 """
 
 from __future__ import annotations
@@ -38,8 +39,8 @@ if importlib.util.find_spec("coursekit") is None:
 _WITHOUT_REPOSITORY = _HEADER + '''import importlib.util
 if importlib.util.find_spec("coursekit") is None:
     raise ModuleNotFoundError(
-        'coursekit is missing: run %pip install "coursekit @ git+https://github.com/OWNER/NAME" with '
-        "the address of the repository these notebooks come from, then run this cell again.")'''
+        "coursekit is missing: install it from the course repository these notebooks come from "
+        "(its README), then run this cell again.")'''
 
 _URL = re.compile(r"^https://[A-Za-z0-9.\-]+(:[0-9]+)?/[A-Za-z0-9_.\-/~]+$")
 _CELL_URL = re.compile(r'"coursekit @ git\+([^"]+)"\], check=True\)')

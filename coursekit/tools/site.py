@@ -318,7 +318,8 @@ def sphinx_conf(*, title: str) -> str:
 project = {title!r}
 author = "coursekit"
 extensions = ["myst_nb", "sphinx-mathjax-offline"]
-exclude_patterns = ["_build", "**.ipynb_checkpoints"]
+# downloads/ holds the notebooks to download (the {{download}} role copies them), not pages to build
+exclude_patterns = ["_build", "**.ipynb_checkpoints", "downloads"]
 master_doc = "index"
 nb_execution_mode = "off"           # the notebooks arrive executed
 nb_merge_streams = True
