@@ -24,21 +24,6 @@ def sorted_eig(values):
 
 @pytest.fixture(scope="session")
 def executed_chapters(tmp_path_factory):
-    """edition ("instructor" or "student") -> its chapter notebooks executed, once per session
-    (tests/executed_chapters.py says with what and who reads them)."""
-    from executed_chapters import execute_edition
-    done = {}
-
-    def executed(edition: str):
-        if edition not in done:
-            try:
-                done[edition] = execute_edition(edition, tmp_path_factory.mktemp(edition) / "edition")
-            except Exception as error:     # said once in full; the other tests say it again in short
-                done[edition] = f"executing the {edition} edition failed: {type(error).__name__}: " \
-                                f"{str(error)[:2000]}"
-                raise
-        if isinstance(done[edition], str):
-            pytest.fail(done[edition])
-        return done[edition]
-
-    return executed
+    """The chapters executed once per session for the tests that read them (tests/executed_chapters.py)."""
+    from executed_chapters import ExecutedChapters
+    return ExecutedChapters(tmp_path_factory)

@@ -1,16 +1,17 @@
-"""The chapter notebooks executed once per test session and edition, for the tests that only read
-their outputs (the session fixture ``executed_chapters`` of tests/conftest.py hands them out).
+"""The chapter notebooks executed once per test session, for the tests that only read their
+outputs (the session fixture ``executed_chapters`` of tests/conftest.py, an `ExecutedChapters`).
 
-* ``instructor``: the notebooks of ``notebooks/`` with their slide types, executed after a first
-  cell that gives every figure the slides' description (``slideshow.DESCRIBE_FIGURES``) and every
-  figure and explorer its report of `figure_checks` (`notebook_figures.PRELUDE`). The figure-style
-  test reads the reports; the slides of the whole course (tests/test_slides.py) are built from it
-  by `replay_into` instead of executing the notebooks again.
-* ``student``: the student edition as ``python -m coursekit release`` writes it, executed as it
-  is (tests/test_release.py).
+* the instructor edition: each chapter of ``notebooks/`` with its slide types, executed when a
+  test first asks for it, after a first cell (`PRELUDE`) that gives every figure the slides'
+  description (``slideshow.DESCRIBE_FIGURES``) and every figure and explorer its report of
+  `figure_checks` (`notebook_figures.PRELUDE`). The figure-style test reads the reports; the
+  slides of the whole course (tests/test_slides.py) take, by `replay_into`, the chapters executed
+  already (in a full run, all of them) and execute only the others.
+* the student edition: as ``python -m coursekit release`` writes it, executed as it is
+  (tests/test_release.py).
 
 nbval executes every notebook as its own test besides; the website's build executes its own, since
-it draws every figure for its page's column. The notebooks of an edition run side by side, one
+it draws every figure for its page's column. Chapters asked for together run side by side, one
 kernel per core at a time, in kernels of this interpreter.
 """
 
@@ -23,49 +24,83 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import nbformat
+import pytest
 
+from coursekit.tools.slideshow import DESCRIBE_FIGURES
 from kernels import this_python_kernel
+from notebook_figures import PRELUDE as FIGURE_CHECKS
 
-__all__ = ["EDITIONS", "Executed", "execute_edition", "replay_into"]
+__all__ = ["PRELUDE", "Executed", "ExecutedChapters", "replay_into"]
 
-EDITIONS = ("instructor", "student")
-
+#: the first cell of the instructor edition: the slides' figure descriptions, the figure checks
+PRELUDE = DESCRIBE_FIGURES + FIGURE_CHECKS
 
 @dataclass
 class Executed:
-    """One edition executed: the files executed (`paths`) and their executed notebooks, whose first
-    cell is `prelude` when there is one."""
+    """The student edition executed: the files written and executed and their executed notebooks."""
     paths: list[Path]
     notebooks: list
-    prelude: str | None
-
-    def notebook(self, name: str):
-        """The executed notebook of the file called `name`."""
-        return self.notebooks[[p.name for p in self.paths].index(name)]
 
 
-def execute_edition(edition: str, folder: Path) -> Executed:
-    """Execute the chapter notebooks of `edition` (``instructor`` or ``student``, written into
-    `folder`, an empty folder, for the student edition)."""
-    from coursekit.tools.chapters import chapter_notebooks
-    from coursekit.tools.release import build_release, default_notebook_dir
-    if edition not in EDITIONS:
-        raise ValueError(f"edition must be one of {EDITIONS}, got {edition!r}")
-    if edition == "student":
-        paths = build_release(folder)
-        notebooks = [nbformat.read(path, as_version=4) for path in paths]
-        prelude = None
-    else:
-        from coursekit.tools.slides import with_slide_metadata
-        from coursekit.tools.slideshow import DESCRIBE_FIGURES
-        from notebook_figures import PRELUDE
-        paths = chapter_notebooks(default_notebook_dir())
-        notebooks = [with_slide_metadata(nbformat.read(path, as_version=4)) for path in paths]
-        prelude = DESCRIBE_FIGURES + PRELUDE
-        for nb in notebooks:
-            nb.cells.insert(0, nbformat.v4.new_code_cell(prelude))
+class ExecutedChapters:
+    """The chapters this session executed. `instructor(names)` and `student()` execute what was
+    not executed yet (side by side) and hand out the executed notebooks; `has_instructor(name)`
+    says whether that chapter's is there, without executing it. A chapter that failed fails every
+    test that asks for it, with the message, and is not executed again."""
+
+    def __init__(self, tmp_path_factory):
+        self._tmp = tmp_path_factory
+        self._done = {}     # ("instructor", file name) or ("student", "") -> result or failure message
+
+    def instructor(self, names: list[str]) -> list:
+        """The executed notebooks of the instructor edition's files called `names`."""
+        missing = [name for name in names if ("instructor", name) not in self._done]
+        if missing:
+            self._run([("instructor", name) for name in missing], lambda: _execute_instructor(missing))
+        return [self._ready(("instructor", name)) for name in names]
+
+    def has_instructor(self, name: str) -> bool:
+        return not isinstance(self._done.get(("instructor", name), ""), str)
+
+    def student(self) -> Executed:
+        if ("student", "") not in self._done:
+            self._run([("student", "")], lambda: [_execute_student(self._tmp.mktemp("student") / "edition")])
+        return self._ready(("student", ""))
+
+    def _run(self, keys: list, run) -> None:
+        try:
+            self._done.update(zip(keys, run()))
+        except Exception as error:
+            message = f"executing {', '.join(k[1] or k[0] for k in keys)} failed: {type(error).__name__}: "
+            self._done.update(dict.fromkeys(keys, message + str(error)[:2000]))
+            raise
+
+    def _ready(self, key):
+        if isinstance(self._done[key], str):
+            pytest.fail(self._done[key])
+        return self._done[key]
+
+
+def _execute_instructor(names: list[str]) -> list:
+    """The instructor edition's chapters called `names`, with their slide types, executed after
+    the slides' first cell and the figure checks' (`PRELUDE`)."""
+    from coursekit.tools.release import default_notebook_dir
+    from coursekit.tools.slides import with_slide_metadata
+    paths = [default_notebook_dir() / name for name in names]
+    notebooks = [with_slide_metadata(nbformat.read(path, as_version=4)) for path in paths]
+    for nb in notebooks:
+        nb.cells.insert(0, nbformat.v4.new_code_cell(PRELUDE))
     asyncio.run(_execute_all(notebooks, paths))
-    return Executed(paths, notebooks, prelude)
+    return notebooks
+
+
+def _execute_student(folder: Path) -> Executed:
+    """The student edition as ``python -m coursekit release`` writes it into `folder`, executed."""
+    from coursekit.tools.release import build_release
+    paths = build_release(folder)
+    notebooks = [nbformat.read(path, as_version=4) for path in paths]
+    asyncio.run(_execute_all(notebooks, paths))
+    return Executed(paths, notebooks)
 
 
 async def _execute_all(notebooks: list, paths: list[Path]) -> None:

@@ -23,7 +23,7 @@ NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))
 
 @pytest.fixture(scope="module")
 def release(executed_chapters):
-    student = executed_chapters("student")
+    student = executed_chapters.student()
     return {"paths": student.paths, "stored": [read_notebook(p) for p in student.paths],
             "executed": student.notebooks}
 
