@@ -19,9 +19,10 @@ steps apart, and both ends of its range). The range inputs step through exactly 
 and on the star a slider moved while another stands away from its default brings that one back
 to it: every state a reader can reach shows the figure computed for exactly those settings.
 
-The frame of settings S is what the explorer shows in JupyterLab after one move from its
-defaults to S, at rest: the view limits it had for its defaults, then its update for S (and,
-when ``compute`` fails for S, the figure of the defaults with the readout saying why, as there).
+The frame of settings S is what the explorer draws after one move from its defaults to S, at
+rest, as in JupyterLab: the view limits it had for its defaults, then its update for S (and,
+when ``compute`` fails for S, the figure of the defaults with the readout saying why), laid out
+for S (`render_settled`), so that no frame depends on the frames drawn before it.
 The frames are lossless (WebP through Pillow), at most `FRAME_BUDGET` bytes per explorer
 (fewer values per slider when they would be more) and `SITE_BUDGET` for a whole build.
 """
@@ -42,8 +43,8 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["MIME", "MAX_FRAMES", "FULL_GRID_MIN", "FRAME_BUDGET", "SITE_BUDGET", "ASSETS", "ASSET_FILES",
-           "slider_values", "plan", "render_frames", "explorer_data", "install", "explorer_html", "publish",
-           "copy_assets", "check_site_budget"]
+           "slider_values", "plan", "render_settled", "render_frames", "explorer_data", "install",
+           "explorer_html", "publish", "copy_assets", "check_site_budget"]
 
 #: the media type under which the kernel adds an explorer's frames to its display data
 MIME = "application/x-coursekit-static-explorer+json"
@@ -198,11 +199,23 @@ def _move(explorer, settings: dict, defaults: dict, view) -> None:
         explorer._apply(defaults)
 
 
+def render_settled(explorer, passes: int = 4) -> None:
+    """Render the explorer's figure with its layout settled: laid out again until its axes stay
+    where they are (constrained layout counts the ticks of axes placed by the previous layout, so
+    one pass depends on where they stood; a blit keeps the background's layout, that of the same
+    limits and text). The frame then does not depend on the frames drawn before it."""
+    for _ in range(passes):
+        places = [ax.get_position().bounds for ax in explorer.fig.axes]
+        explorer.frames.relayout()
+        explorer.frames.render()
+        if [ax.get_position().bounds for ax in explorer.fig.axes] == places:
+            return
+
+
 def _one_frame(explorer, settings: dict, defaults: dict, view, dpi: float) -> dict:
     """The frame of `settings`: one move from the defaults, at rest."""
     _move(explorer, settings, defaults, view)
-    explorer.frames.relayout()      # a blit keeps the background's layout: that of the same limits
-    explorer.frames.render()
+    render_settled(explorer)
     text = explorer.text
     width, height = explorer.frames.canvas.get_width_height(physical=True)
     return dict(image=_webp(explorer.frames.canvas.buffer_rgba()), alt=explorer._alt(text, settings),
