@@ -11,7 +11,7 @@
     root.dataset.ckReady = "true";
     const data = JSON.parse(root.querySelector("script.ck-static-data").textContent);
     const inputs = [...root.querySelectorAll("[data-ck-control]")];
-    const img = root.querySelector("img.ck-static-figure");
+    let img = root.querySelector("img.ck-static-figure");
     const readout = root.querySelector(".ck-static-readout");
     const live = root.querySelector(".ck-static-live");
     let settle = null, preloaded = null, shown = -1;
@@ -20,13 +20,15 @@
     const index = input => input.tagName === "SELECT" ? input.selectedIndex : Number(input.value);
     const key = state => state.join(",");
 
-    function preload() {   // every frame fetched and decoded once, before a hand needs it
+    // every frame fetched and decoded once, before a hand needs it: a swap puts the decoded image
+    // in place of the one shown (setting the src of the shown one would decode it again)
+    function preload() {
       if (preloaded) return preloaded;
       preloaded = Promise.all(data.frames.map(frame => {
-        const image = new Image();
+        const image = img.cloneNode(false);
         image.src = frame.src;
-        frame.image = image;
-        return image.decode().catch(() => undefined);
+        image.alt = frame.alt;
+        return image.decode().then(() => { frame.image = image; }, () => undefined);
       })).then(() => { root.dataset.ckLoaded = "true"; });
       return preloaded;
     }
@@ -45,8 +47,13 @@
     function show(n) {
       const frame = data.frames[n];
       if (n !== shown) {
-        img.src = frame.src;
-        img.alt = frame.alt;
+        if (frame.image && frame.image !== img) {
+          img.replaceWith(frame.image);
+          img = frame.image;
+        } else if (!frame.image) {
+          img.src = frame.src;
+          img.alt = frame.alt;
+        }
         readout.replaceChildren(...frame.readout.split("\n").flatMap((line, i) =>
           i ? [document.createElement("br"), line] : [line]));
         shown = n;
