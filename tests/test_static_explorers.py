@@ -112,13 +112,17 @@ def _one_move(factory, settings: dict, *, column: bool) -> tuple[np.ndarray, str
     """The figure a fresh explorer shows in JupyterLab after one move to `settings` (a single
     control changed), as the website draws it (`column`) or at its natural size, and its alt."""
     fresh = factory()
+    places = [(ax, ax.get_position(original=True)) for ax in fresh.fig.axes]   # where the defaults put them
     changed = {name: value for name, value in settings.items() if fresh.params[name] != value}
     assert len(changed) <= 1, changed
     with (drawn_for_the_column(fresh.fig, fresh.natural_dpi) if column else _natural(fresh)):
         for name, value in changed.items():
             fresh.controls[name].value = value
+        for ax, place in places:             # laid out from there, as the build does for each frame
+            ax.set_position(place)
+            ax.set_in_layout(True)
         fresh.frames.reset()                 # a full draw: not blitted over the defaults' layout
-        se.render_settled(fresh)             # its layout settled, wherever the axes stood
+        se.render_settled(fresh)
         return np.asarray(fresh.frames.canvas.buffer_rgba())[..., :3].astype(int), fresh.alt
 
 
