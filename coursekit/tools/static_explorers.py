@@ -292,7 +292,9 @@ def install(shell, *, column: bool) -> None:
     display = shell.display_formatter
     formatter = StaticExplorerFormatter(parent=display)
     formatter.for_type(Explorer, lambda explorer: explorer_data(explorer, column=column))
-    display.formatters[MIME] = formatter
+    # first, before a formatter draws the figure (the website's draws it for the column and back,
+    # which moves its axes): the frames start where the explorer laid its axes out, as JupyterLab's
+    display.formatters = {MIME: formatter, **{k: v for k, v in display.formatters.items() if k != MIME}}
     display.active_types = [*display.active_types, MIME]
 
 
