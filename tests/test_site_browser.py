@@ -35,6 +35,7 @@ from coursekit.tools import site
 from coursekit.tools.chapters import chapter_notebooks
 
 import lab_harness  # the browser test's Chromium location and settings
+import static_explorer_checks  # the explorers' sliders on a static page
 
 pytestmark = pytest.mark.browser
 
@@ -278,25 +279,39 @@ def _check_chapter(v, name: str, report: dict) -> None:
 @pytest.mark.parametrize("name", CHAPTERS)
 def test_figure_text_is_11_css_px_or_more_in_a_1280_px_window(name, edition, built, server, visit):
     folder = built[edition]
-    record = json.loads((folder / "_static" / site.FIGURE_RECORD).read_text(encoding="utf-8"))["smallest_text_pt"]
+    figures = json.loads((folder / "_static" / site.FIGURE_RECORD).read_text(encoding="utf-8"))
+    record, dpi = figures["smallest_text_pt"], figures["dpi"]
     v = visit(f"{server}/{edition}/{name}.html", width=FIGURE_WINDOW)
     images = v.page.evaluate(FIGURE_REPORT)
     assert images, "a chapter page without a figure"
     small, unknown = [], []
     for image in images:
         path = folder / image["src"]
-        points = record.get(hashlib.sha256(path.read_bytes()).hexdigest())
+        digest = hashlib.sha256(path.read_bytes()).hexdigest()
+        points = record.get(digest)
         if points is None:
             unknown.append(image["src"])
             continue
-        with Image.open(path) as png:
-            pixels_per_point = png.info["dpi"][0] / 72
+        with Image.open(path) as png:      # an explorer's WebP frame: its resolution is recorded
+            pixels_per_point = png.info.get("dpi", (dpi.get(digest),))[0] / 72
         shown = points * pixels_per_point * image["shown"] / image["natural"]
         if shown < SMALLEST_TEXT_PX:
             small.append(f"{image['src']}: {points:g} pt at {pixels_per_point * 72:.0f} dpi, shown "
                          f"{image['shown']:.0f} of {image['natural']} px wide: {shown:.1f} CSS px")
     assert not unknown, f"images without a recorded smallest text: {unknown}"
     assert not small, "figure text below 11 CSS px:\n" + "\n".join(small)
+
+
+@pytest.mark.parametrize("edition", EDITIONS)
+@pytest.mark.parametrize("name", CHAPTERS)
+def test_explorers_are_live_without_a_kernel(name, edition, built, server, visit):
+    """Every state a reader reaches shows its frame; dragging each slider swaps the figure and its
+    alt text once per value passed and ends on the figure the explorer renders for those settings
+    (`static_explorer_checks`), at the window the figures are drawn for."""
+    v = visit(f"{server}/{edition}/{name}.html", width=FIGURE_WINDOW)
+    checked = static_explorer_checks.check_page(v.page, built[edition], column=True)
+    assert checked == len(v.page.evaluate(EXPLORER_REPORT)) > 0
+    assert v.outside == [] and v.errors == []
 
 
 @pytest.mark.parametrize("name", CHAPTERS)

@@ -31,6 +31,7 @@ from coursekit.tools.site import ALT, WIDGET_VIEW
 from coursekit.tools.slides import apply_slide_metadata, slide_types, with_slide_metadata
 
 import lab_harness  # the browser tests' Chromium location, settings and axe-core
+import static_explorer_checks  # the explorers' sliders on a static page
 from executed_chapters import replay_into
 from notebook_figures import REPORT
 
@@ -447,4 +448,33 @@ def test_index_page_opens_every_chapter(course, opened):
     view.page.click("main a >> nth=-1")
     view.wait_for_reveal()
     assert view.page.url.split("#")[0].endswith(f"{CHAPTERS[-1].stem}{slideshow.SUFFIX}")
+    view.assert_offline_and_clean()
+
+
+def _show_slide(view):
+    """Bring the slide that holds an explorer on screen (reveal.js shows one slide at a time)."""
+    def show(root):
+        view.page.evaluate("e => { const i = Reveal.getIndices(e.closest('section')); Reveal.slide(i.h, i.v); }",
+                           root.element_handle())
+        view.page.wait_for_function("e => e.closest('section').classList.contains('present')",
+                                    arg=root.element_handle())
+        view.page.wait_for_timeout(900)          # the slide transition
+        root.scroll_into_view_if_needed()
+    return show
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("path", CHAPTERS, ids=lambda p: p.stem)
+def test_explorers_are_live_on_the_slides(path, course, opened):
+    """On its slide, every state a reader reaches shows its frame; dragging each slider swaps the
+    figure and its alt text once per value passed and ends on the figure the explorer renders for
+    those settings (`static_explorer_checks`); the arrow keys move the slider, not the slides."""
+    view = opened((course / f"{path.stem}{slideshow.SUFFIX}").as_uri())
+    view.wait_for_reveal()
+    checked = static_explorer_checks.check_page(view.page, course, column=False, scroll=_show_slide(view))
+    assert checked == sum(bool(re.search(r"\b\w+_explorer\(", c.source))
+                          for c in read_notebook(path).cells if c.cell_type == "code") > 0
+    # the arrow keys pressed on the last explorer's sliders left its slide on screen
+    assert view.page.evaluate("Reveal.getCurrentSlide().contains([...document.querySelectorAll("
+                              "'.ck-static-explorer')].pop())")
     view.assert_offline_and_clean()

@@ -243,9 +243,11 @@ class Explorer:
         """The figure's text alternative: the title, the settings and the readout."""
         return self._alt(self.text)
 
-    def _alt(self, text: str) -> str:
+    def _alt(self, text: str, params: dict | None = None) -> str:
+        """The text alternative for the readout `text` and the settings `params` (default: the
+        controls' values; a static page gives those of each frame it stores)."""
         settings = ", ".join(f"{k} = {v:g}" if isinstance(v, (int, float)) else f"{k} = {v}"
-                             for k, v in self.params.items())
+                             for k, v in (self.params if params is None else params).items())
         return f"{self.title}. Settings: {settings}." + (f" {text}".replace("\n", "; ") if text else "")
 
     def _apply(self, params: dict) -> None:

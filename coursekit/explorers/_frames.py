@@ -48,12 +48,24 @@ class FrameRenderer:
         self.full_draws = self.blits = 0
 
     def reset(self) -> None:
-        """Forget the background: the next frame is a full draw."""
-        self._background = None
+        """Forget the background and the layout: the next frame is a full draw, laid out anew (the
+        figure may have been drawn elsewhere meanwhile, e.g. at another size, moving its axes)."""
+        self._background = self._layout = None
 
     def frame(self) -> bytes:
         """The figure as it is now, as PNG bytes (blitted when only moving artists changed). The
         artists changed since the last frame (all before the first) move from the second on."""
+        self.render()
+        return encode_png(self.canvas.buffer_rgba(), self.fig.dpi)
+
+    def relayout(self) -> None:
+        """Make the next full draw lay the figure out anew, even when its text measures as before
+        (a static page stores each frame as a full draw at its settings would show it)."""
+        self._layout = None
+
+    def render(self) -> None:
+        """`frame` without the PNG: the canvas (``canvas.buffer_rgba()``) shows the figure as it is
+        now (the static pages encode it themselves, `coursekit.tools.static_explorers`)."""
         changed = {a for a in self._children() if a.stale} if self.full_draws else set()
         new = changed - self.moving
         self.moving |= changed
@@ -63,7 +75,6 @@ class FrameRenderer:
             self.canvas.restore_region(self._background)
             self._draw_animated()
             self.blits += 1
-        return encode_png(self.canvas.buffer_rgba(), self.fig.dpi)
 
     def _parents(self):
         return (*self.fig.axes, self.fig)

@@ -5,11 +5,12 @@ directory and needs no network:
 
 1. copy the chapter notebooks (for ``student=True`` the student edition: solutions removed);
 2. execute each one with nbclient, without storing widget state, and drop the widget views
-   from the outputs, so every explorer shows its static ``image/png`` figure (the figure for
-   the default slider values) instead of an empty widget area; the kernel draws every figure
+   from the outputs, so that no empty widget area is left; the kernel draws every figure
    for the page's column, so that its smallest text is 11 CSS px or more at a 1,280-px window,
    describes it for its ``alt`` and notes the size of its smallest text, which the site
-   records in ``_static/coursekit-figures.json`` (`coursekit.tools.site_figures`);
+   records in ``_static/coursekit-figures.json`` (`coursekit.tools.site_figures`); it also
+   renders each explorer's figure for the settings its sliders stop at, which the page swaps as
+   native range inputs move, with no kernel (`coursekit.tools.static_explorers`);
 3. rewrite the erratum paragraphs of the markdown cells into admonitions styled as boxes, and
    fold the old-style solution code cells behind a "Show solution" click (solutions written as
    markdown ``<details>`` blocks fold by themselves);
@@ -36,6 +37,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from . import static_explorers
 from .cells import ENVIRONMENT, INSTALL, is_solution, role
 from .builds import start_build
 
@@ -280,8 +282,9 @@ One notebook per chapter of the lecture notes, executed, with every figure. Sect
 equation numbers are those of the notes. Boxes marked *Erratum* point out slips in the notes and
 show the corrected computation. {edition}
 
-The sliders of the explorers need a running notebook: here each explorer shows its figure for the
-default values of its sliders.
+The explorers' sliders work on these pages too: each figure was computed when the site was built,
+for the values the sliders stop at (a line under each explorer says which settings are live); a
+running notebook computes every setting.
 
 ## Chapters
 
@@ -331,8 +334,8 @@ suppress_warnings = ["myst.header", "mystnb.unknown_mime_type"]
 html_theme = "sphinx_book_theme"
 html_title = {title!r}
 html_static_path = ["_static"]
-html_css_files = ["coursekit.css"]
-html_js_files = ["coursekit.js"]
+html_css_files = ["coursekit.css", "ck-explorers/explorers.css"]
+html_js_files = ["coursekit.js", "ck-explorers/explorers.js"]
 html_theme_options = {{
     "home_page_in_toc": True,
     "show_toc_level": 2,
@@ -426,12 +429,15 @@ def _prepare(path: Path, src: Path, *, student: bool, timeout: int) -> dict:
     describe_images(nb)
     sizes = figure_text_sizes(nb)
     strip_widget_views(nb)
+    frames = static_explorers.publish(nb, src / "_static" / static_explorers.ASSETS,
+                                      f"_static/{static_explorers.ASSETS}", stem=path.stem)
     fold_solution_code(nb)
     for cell in nb.cells:
         if cell.cell_type == "markdown":
             cell.source = erratum_admonitions(_source(cell))
     nbformat.write(nb, src / path.name)
-    return {**chapter_entry(nb, path.stem), "smallest_text_pt": sizes}
+    sizes.update({f["sha256"]: f["smallest_text_pt"] for f in frames if f["smallest_text_pt"] is not None})
+    return {**chapter_entry(nb, path.stem), "smallest_text_pt": sizes, "frames": frames}
 
 
 def repository_of(nb) -> str | None:
@@ -458,7 +464,8 @@ ALT = "text/x-coursekit-alt"
 #: the media type under which it adds the size of each figure's smallest text, in points
 SMALLEST_TEXT = "text/x-coursekit-smallest-text-pt"
 #: the file of the site, under ``_static``, that gives the size in points of the smallest text of
-#: each image (``{"smallest_text_pt": {sha256 of the PNG: size}}``)
+#: each image and the resolution of the explorers' frames, which WebP does not carry
+#: (``{"smallest_text_pt": {sha256 of the image: size}, "dpi": {sha256 of a frame: dots per inch}}``)
 FIGURE_RECORD = "coursekit-figures.json"
 
 #: run first in each notebook the site executes: figures and explorers drawn for the page's
@@ -518,11 +525,15 @@ def _write_sources(src: Path, chapters: list[dict], *, student: bool, repository
     (src / "index.md").write_text(landing_page(chapters, student=student, run_online=run_online(repository)),
                                   encoding="utf-8")
     (src / "conf.py").write_text(sphinx_conf(title=title), encoding="utf-8")
-    (src / "_static").mkdir()
+    (src / "_static").mkdir(exist_ok=True)      # the explorers' frames may be there already
+    static_explorers.copy_assets(src / "_static" / static_explorers.ASSETS)
+    frames = [f for chapter in chapters for f in chapter.get("frames", [])]
+    static_explorers.check_site_budget(frames, what="the site")
     (src / "_static" / "coursekit.css").write_text(CSS, encoding="utf-8")
     (src / "_static" / "coursekit.js").write_text(JS, encoding="utf-8")
     record = {digest: size for chapter in chapters for digest, size in chapter.get("smallest_text_pt", {}).items()}
-    (src / "_static" / FIGURE_RECORD).write_text(json.dumps({"smallest_text_pt": record}, indent=1),
+    dpi = {f["sha256"]: f["dpi"] for f in frames}        # a WebP frame does not carry its resolution
+    (src / "_static" / FIGURE_RECORD).write_text(json.dumps({"smallest_text_pt": record, "dpi": dpi}, indent=1),
                                                  encoding="utf-8")
 
 

@@ -146,3 +146,5 @@ def install(shell) -> None:
     display.formatters["image/png"] = png
     add_output(shell, ALT, describe_figure, explorers=False)
     add_output(shell, SMALLEST_TEXT, lambda fig: repr(smallest_text_pt(fig)), explorers=True)
+    from . import static_explorers        # the explorers' frames, live on the page without a kernel
+    static_explorers.install(shell, column=True)

@@ -6,9 +6,10 @@ neither do the slides:
 
 1. each notebook gets the slide types of `coursekit.tools.slides` (in memory: the notebooks
    are not rewritten) and is executed with nbclient, the kernels side by side, without storing
-   widget state, so every explorer shows its static figure for the default slider values (the
-   slides have no kernel); each figure gets its text alternative from its data, as on the
-   website (`DESCRIBE_FIGURES`, with the website's `coursekit.tools.site_figures.add_output`);
+   widget state; each figure gets its text alternative from its data, as on the website
+   (`DESCRIBE_FIGURES`, with the website's `coursekit.tools.site_figures.add_output`), and each
+   explorer its frames for the settings its sliders stop at: on the slides its sliders are native
+   range inputs that swap the frames, with no kernel (`coursekit.tools.static_explorers`);
 2. nbconvert's ``SlidesExporter`` writes the slides with the template ``coursekit_reveal``
    (shipped in this package), which extends nbconvert's reveal template and loads reveal.js and
    MathJax 3 from the folder: no jQuery, require.js or mermaid from a CDN, no MathJax 2 (whose
@@ -35,6 +36,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from . import static_explorers
 from .builds import start_build
 from .site import ALT, WIDGET_VIEW, chapter_entry
 from .slides import with_slide_metadata
@@ -48,11 +50,14 @@ SLIDE_TOOLS = {"nbconvert": "nbconvert", "nbclient": "nbclient", "nbformat": "nb
                "sphinx-mathjax-offline": "sphinx-mathjax-offline"}
 
 #: run first in each notebook the slides execute: every figure gets its description under `ALT`
-#: (the figures themselves are drawn as in JupyterLab: a slide is as wide as the screen)
+#: (the figures themselves are drawn as in JupyterLab: a slide is as wide as the screen), every
+#: explorer its frames (`coursekit.tools.static_explorers`)
 DESCRIBE_FIGURES = f"""\
 import coursekit.tools.site_figures as _site_figures
 from coursekit import describe_figure as _describe
 _site_figures.add_output(get_ipython(), {ALT!r}, _describe, explorers=False)
+import coursekit.tools.static_explorers as _static_explorers
+_static_explorers.install(get_ipython(), column=False)
 """
 
 #: the nbconvert template of the slides, a folder of this package
@@ -139,9 +144,10 @@ kbd {{ border: 1px solid #767676; border-radius: 3px; padding: 0 0.3em; }}
 <body>
 <main>
 <h1>State-space control: the course slides</h1>
-<p>One slide show per chapter of the lecture notes, executed: every figure is there, and each
-explorer shows its figure for the default values of its sliders. The slides work without a
-network.</p>
+<p>One slide show per chapter of the lecture notes, executed: every figure is there, and the
+explorers' sliders work, each figure computed when the slides were built for the values the
+sliders stop at (a line under each explorer says which settings are live; a running notebook
+computes every setting). The slides work without a network.</p>
 <p>Keys: <kbd>→</kbd> next section, <kbd>↓</kbd> next part of a section (or <kbd>Space</kbd>
 for the next slide in order), <kbd>Esc</kbd> overview, <kbd>S</kbd> speaker view.</p>
 <ol>
@@ -171,7 +177,10 @@ def build_slides(out_dir, *, notebooks_dir=None, timeout: int = 600, verbose: bo
         folder = Path(tmp) / "slides"
         folder.mkdir()
         _say(verbose, "writing the slides")
-        chapters = [_write_chapter(nb, path, folder) for nb, path in zip(notebooks, sources)]
+        frames = []
+        chapters = [_write_chapter(nb, path, folder, frames) for nb, path in zip(notebooks, sources)]
+        static_explorers.check_site_budget(frames, what="the slides")
+        static_explorers.copy_assets(folder / static_explorers.ASSETS)
         for name, source in assets.items():
             shutil.copytree(source, folder / name)
         (folder / "index.html").write_text(index_page(chapters), encoding="utf-8")
@@ -226,8 +235,11 @@ async def _execute_all(notebooks, sources, *, timeout: int, workers: int, verbos
     await asyncio.gather(*(run(nb, path) for nb, path in zip(notebooks, sources)))
 
 
-def _write_chapter(nb, path: Path, folder: Path) -> dict:
-    """Write the slides of the executed notebook `nb` (read from `path`); return its index entry."""
+def _write_chapter(nb, path: Path, folder: Path, frames: list) -> dict:
+    """Write the slides of the executed notebook `nb` (read from `path`) and its explorers' frames
+    (their entries added to `frames`); return its index entry."""
+    frames += static_explorers.publish(nb, folder / static_explorers.ASSETS, static_explorers.ASSETS,
+                                       stem=path.stem)
     entry = chapter_entry(nb, path.stem)
     nb.metadata["title"] = f"Chapter {entry['number']}: {entry['title']}"
     body, _ = slides_exporter().from_notebook_node(nb, resources={"metadata": {"name": path.stem}})

@@ -1,0 +1,183 @@
+"""The explorers of a static page (the website, the slides) driven in Chromium: shared by
+tests/test_site_browser.py and tests/test_slides.py (coursekit.tools.static_explorers builds them).
+
+`check_page` opens nothing itself: it takes a Playwright page already showing a chapter and the
+folder its frames are read from, and for every explorer on it
+
+* waits until its frames are loaded, and checks that every input has its label;
+* steps each range input through all its values with the keyboard (arrow keys), for each choice
+  of each dropdown: every state a reader reaches shows a loaded frame whose text alternative
+  names exactly the settings the inputs stand at (no reachable state without its frame);
+* drags each range input with the mouse across its track: the figure and its alt text change,
+  each value the hand passes is one swap of the frame (a count, not a time), the polite live
+  region announces the figure once the slider rests, and the figure shown is, pixel for pixel,
+  the one the explorer renders in this process for the settings the slider snapped to (but for
+  the robot planner's equal-aspect path: `test_static_explorers.assert_shows`).
+"""
+
+from __future__ import annotations
+
+import io
+import json
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+from coursekit.tools.chapters import explorer_factories
+
+__all__ = ["check_page", "factories_by_title"]
+
+_STATE_JS = """root => {
+  const img = root.querySelector('img.ck-static-figure');
+  return {frame: Number(root.dataset.ckFrame), src: img.getAttribute('src'), alt: img.alt,
+          loaded: img.complete && img.naturalWidth > 0, natural: [img.naturalWidth, img.naturalHeight],
+          swaps: root.ckSwaps, live: root.querySelector('.ck-static-live').textContent,
+          readout: root.querySelector('.ck-static-readout').innerText,
+          state: [...root.querySelectorAll('[data-ck-control]')].map(i =>
+            i.tagName === 'SELECT' ? i.selectedIndex : Number(i.value)),
+          valuetexts: [...root.querySelectorAll('input[type=range]')].map(i => i.getAttribute('aria-valuetext'))};
+}"""
+
+_LABELS_JS = """root => [...root.querySelectorAll('[data-ck-control]')].map(i =>
+  i.labels.length === 1 && i.labels[0].textContent.trim().length > 0)"""
+
+_SET_JS = """(root, [j, index]) => {
+  const input = root.querySelectorAll('[data-ck-control]')[j];
+  if (input.tagName === 'SELECT') input.selectedIndex = index; else input.value = String(index);
+  input.dispatchEvent(new Event('input', {bubbles: true}));
+}"""
+
+_COUNT_JS = """root => { root.ckInputs = 0;
+  root.querySelectorAll('[data-ck-control]').forEach(i => i.addEventListener('input', () => {
+    const key = [...root.querySelectorAll('[data-ck-control]')].map(x =>
+      x.tagName === 'SELECT' ? x.selectedIndex : x.value).join(',');
+    if (key !== root.ckLastKey) { root.ckInputs += 1; root.ckLastKey = key; }
+  }));
+  root.ckLastKey = [...root.querySelectorAll('[data-ck-control]')].map(x =>
+      x.tagName === 'SELECT' ? x.selectedIndex : x.value).join(','); }"""
+
+
+_FACTORIES: dict = {}
+
+
+def factories_by_title() -> dict:
+    """{an explorer's title: its factory} for every explorer of the course."""
+    if not _FACTORIES:
+        for factory in explorer_factories().values():
+            _FACTORIES[factory().title] = factory
+    return _FACTORIES
+
+
+def _settings_text(data: dict, state: list[int]) -> str:
+    """The "Settings: ..." part of the alt text for `state`, formatted as `Explorer._alt` does."""
+    parts = []
+    for control, index in zip(data["controls"], state):
+        value = control["values"][index]
+        parts.append(f"{control['name']} = {value:g}" if isinstance(value, (int, float)) else
+                     f"{control['name']} = {value}")
+    return "Settings: " + ", ".join(parts) + "."
+
+
+def _pixels(path: Path) -> np.ndarray:
+    return np.asarray(Image.open(io.BytesIO(path.read_bytes())).convert("RGB")).astype(int)
+
+
+def _data(root) -> dict:
+    """The explorer's data (`explorer_data` without the frames' images) as the page holds it."""
+    script = json.loads(root.locator("script.ck-static-data").text_content())
+    controls = [dict(name=None, values=values, texts=texts, kind=kind, default=default)
+                for values, texts, kind, default in zip(script["values"], script["texts"], script["kinds"],
+                                                        script["defaults"])]
+    return dict(script=script, controls=controls)
+
+
+def _names(factory, data: dict) -> None:
+    explorer = factory()
+    for control, name in zip(data["controls"], explorer.controls):
+        control["name"] = name
+
+
+def _step_everywhere(page, root, data: dict, shown: list) -> None:
+    """Every value of every range input, with the keyboard, for each choice of each dropdown."""
+    controls = data["controls"]
+    selects = [j for j, c in enumerate(controls) if c["kind"] == "select"]
+    choices = [[]] + [[(j, i)] for j in selects for i in range(len(controls[j]["values"]))]
+    for choice in choices:
+        for j, c in enumerate(controls):
+            root.evaluate(_SET_JS, [j, c["default"]]) if c["kind"] == "range" else None
+        for j, i in choice:
+            root.evaluate(_SET_JS, [j, i])
+        for j, control in enumerate(controls):
+            if control["kind"] != "range":
+                continue
+            handle = root.locator("[data-ck-control]").nth(j)
+            handle.focus()
+            page.keyboard.press("Home")
+            for _ in range(len(control["values"])):
+                state = root.evaluate(_STATE_JS)
+                assert state["loaded"], f"a reachable state without a loaded frame: {state}"
+                assert _settings_text(data, state["state"]) in state["alt"], (state["state"], state["alt"])
+                assert state["valuetexts"][sum(c["kind"] == "range" for c in controls[:j])] == \
+                    control["texts"][state["state"][j]]
+                shown.append(tuple(state["state"]))
+                page.keyboard.press("ArrowRight")
+
+
+def _drag(page, root, j: int, count: int) -> dict:
+    """Drag range input `j` from its default to the far end of its track in `count` moves."""
+    box = root.locator("[data-ck-control]").nth(j).bounding_box()
+    before = root.evaluate(_STATE_JS)
+    fraction = before["state"][j] / max(1, count - 1)
+    y, x0 = box["y"] + box["height"] / 2, box["x"] + 8 + fraction * (box["width"] - 16)
+    far = box["x"] + box["width"] - 2 if fraction < 0.5 else box["x"] + 2
+    root.evaluate(_COUNT_JS)
+    page.mouse.move(x0, y)
+    page.mouse.down()
+    for k in range(1, 2 * count + 1):
+        page.mouse.move(x0 + (far - x0) * k / (2 * count), y)
+    page.mouse.up()
+    return before
+
+
+def check_page(page, folder: Path, *, column: bool, scroll=None) -> int:
+    """Check every explorer of the chapter `page` shows (see the module's doc); its frames are
+    files of `folder` (the page's own folder), drawn for the website's column when `column`.
+    `scroll(root)` brings an explorer into view (default: scroll it into view). Returns how many
+    explorers were checked."""
+    from test_static_explorers import assert_shows    # the figure a fresh explorer shows after one move
+    roots = page.locator(".ck-static-explorer")
+    for n in range(roots.count()):
+        root = roots.nth(n)
+        (scroll or (lambda r: r.scroll_into_view_if_needed()))(root)
+        page.wait_for_function("r => r.dataset.ckLoaded === 'true'", arg=root.element_handle(), timeout=60_000)
+        assert all(root.evaluate(_LABELS_JS)), "an input without its label"
+        data = _data(root)
+        title = root.locator(".ck-static-title").inner_text().strip()
+        factory = factories_by_title()[title]
+        _names(factory, data)
+        shown: list = []
+        _step_everywhere(page, root, data, shown)
+        assert set(shown) <= {tuple(map(int, k.split(","))) for k in data["script"]["states"]}
+        for j, control in enumerate(data["controls"]):
+            if control["kind"] != "range":
+                continue
+            for k, c in enumerate(data["controls"]):
+                root.evaluate(_SET_JS, [k, c["default"]])
+            page.wait_for_timeout(50)
+            before = _drag(page, root, j, len(control["values"]))
+            after = root.evaluate(_STATE_JS)
+            moved = abs(after["state"][j] - before["state"][j])
+            assert moved >= len(control["values"]) // 3, (title, j, before["state"], after["state"])
+            assert after["src"] != before["src"] and after["alt"] != before["alt"], title
+            swaps, inputs = after["swaps"] - before["swaps"], root.evaluate("r => r.ckInputs")
+            assert swaps == inputs >= moved, (title, j, swaps, inputs, moved)
+            page.wait_for_function("r => r.querySelector('.ck-static-live').textContent === "
+                                   "r.querySelector('img.ck-static-figure').alt", arg=root.element_handle(),
+                                   timeout=5_000)
+            settings = {c["name"]: c["values"][i] for c, i in zip(data["controls"], after["state"])}
+            frame = _pixels(folder / after["src"])
+            assert list(frame.shape[1::-1]) == after["natural"]
+            alt = assert_shows(factory, settings, frame, column=column)
+            assert after["alt"] == alt, (after["alt"], alt)
+    return roots.count()
