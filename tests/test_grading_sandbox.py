@@ -250,3 +250,40 @@ def test_the_sandbox_never_shows_the_home_or_working_folder(tmp_path, monkeypatc
     assert str(Path(sys.prefix).resolve()) in shown and str((tmp_path / "box").resolve()) in shown
     assert args[args.index(str(inside)) - 1] == "--tmpfs"
     assert "--unshare-all" in args and "--die-with-parent" in args and "--clearenv" in args
+
+
+def _processes_naming(text: str) -> list[str]:
+    """The command lines of the processes whose command line holds `text`."""
+    found = []
+    for pid in filter(str.isdigit, os.listdir("/proc")):
+        try:
+            line = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode(errors="replace")
+        except OSError:
+            continue
+        if text in line:
+            found.append(line)
+    return found
+
+
+@needs_bwrap
+def test_a_grader_stopped_midway_leaves_nothing_running(tmp_path):
+    """Ctrl-C (here SIGKILL) on the grader ends its runners and their sandboxed kernels too."""
+    import subprocess
+    import time
+    folder, scratch = tmp_path / "subs", tmp_path / "scratch"
+    folder.mkdir(), scratch.mkdir()
+    _write(folder, "sleeper.ipynb", [new_code_cell("import time\nwhile True:\n    time.sleep(0.1)")], {})
+    grader = subprocess.Popen([sys.executable, "-m", "coursekit", "grade", "--chapter", "1", str(folder), "--out",
+                               str(tmp_path / "out"), "--timeout", "120", "--jobs", "1"],
+                              env={**os.environ, "TMPDIR": str(scratch)},
+                              stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deadline = time.monotonic() + 90
+    while not any("ipykernel_launcher" in p for p in _processes_naming(str(scratch))):
+        assert time.monotonic() < deadline and grader.poll() is None, "the kernel never started"
+        time.sleep(0.2)
+    grader.kill()
+    grader.wait()
+    deadline = time.monotonic() + 15
+    while _processes_naming(str(scratch)) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    assert _processes_naming(str(scratch)) == []

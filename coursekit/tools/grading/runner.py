@@ -27,8 +27,10 @@ from __future__ import annotations
 import contextlib
 import json
 import math
+import os
 import subprocess
 import sys
+import threading
 import time
 from pathlib import Path
 
@@ -157,8 +159,17 @@ def execute(job: dict, kernels_dir: Path) -> dict:
     return _outcome_of_errors(nb)
 
 
+def _end_with(parent: int) -> None:
+    """End this runner (and so its sandboxed kernel, which dies with it) once `parent`, the
+    grader, is gone: a grader stopped with Ctrl-C leaves nothing running."""
+    while os.getppid() == parent:
+        time.sleep(1)
+    os._exit(3)
+
+
 def main(argv: list[str]) -> int:
     """Command-line entry: print the outcome of running the job's notebook as the last line."""
+    threading.Thread(target=_end_with, args=(os.getppid(),), daemon=True).start()
     job_file = Path(argv[0])
     job = json.loads(job_file.read_text(encoding="utf-8"))
     set_limits(int(job["memory"]) + RUNNER_MEMORY)
