@@ -70,7 +70,7 @@ def factories_by_title() -> dict:
 
 
 def _settings_text(data: dict, state: list[int]) -> str:
-    """The "Settings: ..." part of the alt text for `state`, formatted as `Explorer._alt` does."""
+    """The "Settings: ..." part of the alt text for `state`, formatted as `Explorer.alt_for` does."""
     parts = []
     for control, index in zip(data["controls"], state):
         value = control["values"][index]

@@ -84,11 +84,11 @@ def test_a_drag_draws_the_whole_figure_only_when_its_axes_changed(factory):
     e = factory()
     for name, widget in list(_sliders(e).items())[:2]:
         for value in _drag_values(widget, moves=8):
-            state, moving, draws = e.frames._state(), set(e.frames.moving), e.frames.full_draws
+            state, moving, draws = e.frames.state(), set(e.frames.moving), e.frames.full_draws
             widget.value = value
             e.refresh()
             if e.frames.full_draws > draws and not any(ax.get_aspect() != "auto" for ax in e.fig.axes):
-                assert e.frames._state() != state or e.frames.moving != moving, (
+                assert e.frames.state() != state or e.frames.moving != moving, (
                     f"{name} = {value}: the whole figure was drawn although its axes and its moving "
                     "artists stayed the same")
 

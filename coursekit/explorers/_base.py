@@ -193,7 +193,7 @@ class Explorer:
         self.screen: dict = {}
         self.error: str | None = None
         try:
-            self._apply(self.params)
+            self.apply(self.params)
         except Exception as error:   # noqa: BLE001 - the user's function, named in the message
             raise ValueError(f"the explorer {title!r} could not show its first settings {self.params}: "
                              f"{type(error).__name__}: {error}; fix compute/update or the controls' "
@@ -241,16 +241,18 @@ class Explorer:
     @property
     def alt(self) -> str:
         """The figure's text alternative: the title, the settings and the readout."""
-        return self._alt(self.text)
+        return self.alt_for(self.text)
 
-    def _alt(self, text: str, params: dict | None = None) -> str:
+    def alt_for(self, text: str, params: dict | None = None) -> str:
         """The text alternative for the readout `text` and the settings `params` (default: the
         controls' values; a static page gives those of each frame it stores)."""
         settings = ", ".join(f"{k} = {v:g}" if isinstance(v, (int, float)) else f"{k} = {v}"
                              for k, v in (self.params if params is None else params).items())
         return f"{self.title}. Settings: {settings}." + (f" {text}".replace("\n", "; ") if text else "")
 
-    def _apply(self, params: dict) -> None:
+    def apply(self, params: dict) -> None:
+        """Compute for the settings `params` and update the figure's artists (drawing is the
+        caller's; raises what `compute` raises). `refresh` does it for the controls' values."""
         result = self._results(tuple(params.items()))   # a setting dragged over again: not recomputed
         self._update(self.handles, result)
         self.result = result
@@ -258,7 +260,7 @@ class Explorer:
     def refresh(self) -> None:
         """Recompute for the controls' current values and redraw the figure."""
         try:
-            self._apply(self.params)
+            self.apply(self.params)
             self.error = None
         except Exception as error:   # noqa: BLE001 - shown to the student; the lecture goes on
             self.error = f"{type(error).__name__}: {error}"
@@ -320,7 +322,7 @@ class Explorer:
         with self._view.hold_sync():
             self._view.png = self.png
             self._view.css_width, self._view.css_height = width / ratio, height / ratio
-            self._view.alt = self._alt(text)
+            self._view.alt = self.alt_for(text)
         self._text.value = self._readout_html(text)
 
     def _on_screen(self, screen: dict) -> None:

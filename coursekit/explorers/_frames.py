@@ -69,7 +69,7 @@ class FrameRenderer:
         changed = {a for a in self._children() if a.stale} if self.full_draws else set()
         new = changed - self.moving
         self.moving |= changed
-        if self._background is None or new or self._state() != self._key:
+        if self._background is None or new or self.state() != self._key:
             self._full_draw()
         else:
             self.canvas.restore_region(self._background)
@@ -93,7 +93,7 @@ class FrameRenderer:
                       ax.get_yscale()) for ax in self.fig.axes)
         return self.fig.dpi, tuple(self.fig.get_size_inches()), axes, tuple(t.get_text() for t in self.fig.texts)
 
-    def _state(self):
+    def state(self):
         """What the background shows besides the animated artists."""
         return self._text(), tuple((ax.get_xlim(), ax.get_ylim(), ax.get_position().bounds) for ax in self.fig.axes)
 
@@ -123,7 +123,7 @@ class FrameRenderer:
         self._draw_animated()
         for artist in self._children():      # drawn, or never drawn (an empty title)
             artist.stale = False
-        self._key = self._state()
+        self._key = self.state()
         self.full_draws += 1
 
     def _draw_background(self) -> None:

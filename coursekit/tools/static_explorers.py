@@ -192,11 +192,11 @@ def _move(explorer, settings: dict, defaults: dict, view) -> None:
     """One move from the defaults to `settings`, at rest (see the module's doc)."""
     _restore(view)
     try:
-        explorer._apply(settings)
+        explorer.apply(settings)
         explorer.error = None
     except Exception as error:   # noqa: BLE001 - shown as JupyterLab shows it: the figure stays
         explorer.error = f"{type(error).__name__}: {error}"
-        explorer._apply(defaults)
+        explorer.apply(defaults)
 
 
 def render_settled(explorer, passes: int = 4) -> None:
@@ -218,7 +218,7 @@ def _one_frame(explorer, settings: dict, defaults: dict, view, dpi: float) -> di
     render_settled(explorer)
     text = explorer.text
     width, height = explorer.frames.canvas.get_width_height(physical=True)
-    return dict(image=_webp(explorer.frames.canvas.buffer_rgba()), alt=explorer._alt(text, settings),
+    return dict(image=_webp(explorer.frames.canvas.buffer_rgba()), alt=explorer.alt_for(text, settings),
                 readout=text, smallest_text_pt=_smallest_text_pt(explorer.fig), dpi=dpi,
                 width=width, height=height)
 
@@ -230,7 +230,7 @@ def _drawing_order(explorer, states_settings: list[dict], defaults: dict, view) 
     keys = []
     for settings in states_settings:
         _move(explorer, settings, defaults, view)
-        keys.append(repr(explorer.frames._state()))
+        keys.append(repr(explorer.frames.state()))
     return sorted(range(len(states_settings)), key=keys.__getitem__)
 
 
@@ -249,7 +249,7 @@ def render_frames(explorer, states_settings: list[dict], *, column: bool) -> lis
     finally:
         _restore(view)
         explorer.error = error
-        explorer._apply(defaults)
+        explorer.apply(defaults)
         explorer.frames.reset()
 
 
