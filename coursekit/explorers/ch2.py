@@ -92,8 +92,12 @@ def planner_explorer() -> Explorer:
         rescale(h["ax_u"], axis="x", fill=1.0)   # the shared time axis: [0, 2 T] once the controls rest
 
     def readout(r):
+        speed = np.abs(np.gradient(r["yd"], r["t"]))
+        fastest = int(np.argmax(speed))
         return (f"degree {2 * r['r'] - 1} move to {r['target']:g} m in T = {r['T']:g} s, "
-                f"mass error {r['mass_error']:g} %\n|y(T) - target| = {r['end_error']:.2g} m")
+                f"mass error {r['mass_error']:g} %\nplanned peak speed {speed[fastest]:.3g} m/s at "
+                f"t = {r['t'][fastest]:.2g} s, peak force {np.max(np.abs(r['ud'])):.3g} N, "
+                f"|y(T) - target| = {r['end_error']:.2g} m")
 
     return Explorer(
         title="Trajectory planner (2.30), (2.40): mass-spring-damper m = 1 kg, d = 0.5 N s/m, k = 2 N/m",

@@ -227,9 +227,11 @@ def upright_pendulum_explorer() -> Explorer:
         rescale(h["ax_u"], min_span=0.2)      # N m
 
     def readout(r):
-        verdict = lambda ok: "upright" if ok else "NOT upright"  # noqa: E731
+        def told(name):
+            ok = "upright" if r[f"{name}_ok"] else "NOT upright"
+            return f"{ok}, peak |u| {np.max(np.abs(r[f'u_{name}'])):.3g} N m"
         return (f"start {r['theta0_deg']:g} deg from upright, |u| <= {r['u_max']:g} N m, K = {_gain_text(r['K'])[4:]}\n"
-                f"linear: {verdict(r['linear_ok'])}, feedback linearizing: {verdict(r['fl_ok'])}")
+                f"linear: {told('linear')}; feedback linearizing: {told('fl')}")
 
     return Explorer(
         title="Upright pendulum (m = l = 1, g = 9.81): linear feedback vs feedback linearization",
