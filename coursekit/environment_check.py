@@ -41,7 +41,7 @@ MINIMUM_VERSIONS = {
     "matplotlib": "3.8",
     "ipywidgets": "8.0",
     "anywidget": "0.9",
-    "jupyterlab": "4.0",
+    "jupyterlab": "4.0.2",
 }
 MINIMUM_PYTHON = (3, 10)
 
