@@ -37,8 +37,6 @@ SETTLE_S, MOVING_FILL = 0.3, 0.6
 
 #: True while the frame being drawn follows a control that moves (set by `Explorer`)
 _moving = contextvars.ContextVar("moving", default=False)
-#: True while the frame being drawn is the one a control rests on in a kernel (set by `Explorer`)
-_resting = contextvars.ContextVar("resting", default=False)
 
 
 def _range(value, min, max, step, description):
@@ -100,8 +98,7 @@ def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, ke
     slider moved on in the same direction changes the axes every few steps, not at each
     (each change of the axes is a full draw of the figure). While a hand drags a control of
     an `Explorer` (moves less than `SETTLE_S` apart) the limits only grow, leaving the data
-    `MOVING_FILL` of them; the frame a control rests on (the end of a drag, or a single step such
-    as an arrow key) fits them to the data, shrinking them too. They never go past an artist's
+    `MOVING_FILL` of them, and are fitted as above once it rests. They never go past an artist's
     sticky edges (matplotlib's ``Artist.sticky_edges``: a time axis that starts at 0 gets
     ``line.sticky_edges.x.append(0)``). `axis` is ``"y"``, ``"x"`` or ``"both"``. With
     `min_span`, the view spans at least that much, centred on the data: a response that stays
@@ -131,7 +128,7 @@ def _fit(ax, name: str, min_span: float, fill: float, keep: float) -> None:
     if not hi - lo > 1e-9 * max(abs(lo), abs(hi)):      # a constant: 5 % of it either way (or 0.05)
         half = 0.05 * (abs(lo) or 1.0)
         lo, hi = lo - half, hi + half
-    auto = getattr(ax, f"get_autoscale{name}_on")() or _resting.get()   # at rest in a kernel: fitted
+    auto = getattr(ax, f"get_autoscale{name}_on")()
     moving = _moving.get() and not auto      # a hand moves a control: the limits only grow
     if moving:
         keep, fill = 0.0, min(fill, MOVING_FILL)
@@ -269,34 +266,23 @@ class Explorer:
         self._send()
 
     def _moved(self) -> None:
-        """A control moved. In a kernel (an event loop runs), while each move comes less than
-        `SETTLE_S` after the last frame (a drag) the limits only grow (`rescale`), and a frame
-        with limits fitted to the data follows once the controls rest (it sends nothing when it
-        is the frame shown); a single step is fitted at once."""
+        """A control moved. In a kernel (an event loop runs), while moves come less than `SETTLE_S`
+        apart (a drag) the limits only grow (`rescale`), and a frame with fitted limits follows once
+        the controls rest (it sends nothing when it is the frame shown); else it is fitted at once."""
         loop = self._home.loop
         if loop is None or not loop.is_running():
             return self.refresh()
-        try:
-            if loop.time() - self._last_move > SETTLE_S:   # a single step: fitted at once
-                return self._rest()
-            if self._settle is not None:
-                self._settle.cancel()
-            moving = _moving.set(True)
-            try:
-                self.refresh()
-            finally:
-                _moving.reset(moving)
-                self._settle = loop.call_later(SETTLE_S, self._rest)   # once the controls rest
-        finally:       # from the end of this frame: a slow frame does not split a drag into steps
-            self._last_move = loop.time()
-
-    def _rest(self) -> None:
-        """The frame the controls rest on: `rescale` fits the limits to the data (also shrinks them)."""
-        resting = _resting.set(True)
+        now, last, self._last_move = loop.time(), self._last_move, loop.time()
+        if now - last > SETTLE_S:                         # a single step: fitted at once
+            return self.refresh()
+        if self._settle is not None:
+            self._settle.cancel()
+        self._settle = loop.call_later(SETTLE_S, self.refresh)
+        moving = _moving.set(True)
         try:
             self.refresh()
         finally:
-            _resting.reset(resting)
+            _moving.reset(moving)
 
     def static_png(self) -> bytes:
         """The figure for the current settings at its natural size (what a static page shows)."""

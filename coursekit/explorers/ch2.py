@@ -89,7 +89,7 @@ def planner_explorer() -> Explorer:
         for line in h["marks"]:
             line.set_xdata([r["T"], r["T"]])
         rescale(h["ax_y"], h["ax_u"])
-        rescale(h["ax_u"], axis="x", fill=1.0)   # the shared time axis: [0, 2 T] once the controls rest
+        rescale(h["ax_u"], axis="x")          # the shared time axis [0, 2 T], from 0 on
 
     def readout(r):
         speed = np.abs(np.gradient(r["yd"], r["t"]))
