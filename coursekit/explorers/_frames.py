@@ -48,9 +48,9 @@ class FrameRenderer:
         self.full_draws = self.blits = 0
 
     def reset(self) -> None:
-        """Forget the background and the layout: the next frame is a full draw, laid out anew (the
-        figure may have been drawn elsewhere meanwhile, e.g. at another size, moving its axes)."""
-        self._background = self._layout = None
+        """Forget the background: the next frame is a full draw (with the layout kept unless the
+        text around the axes measures otherwise; `relayout` forgets it too)."""
+        self._background = None
 
     def frame(self) -> bytes:
         """The figure as it is now, as PNG bytes (blitted when only moving artists changed). The

@@ -241,7 +241,8 @@ def render_frames(explorer, states_settings: list[dict], *, column: bool) -> lis
     defaults, error, view = explorer.params, explorer.error, _view(explorer.fig)
     try:
         with _drawn(explorer, column) as dpi:
-            explorer.frames.reset()      # measuring the text for the column drew it at its own size
+            explorer.frames.reset()      # measuring the text for the column drew it at its own size:
+            explorer.frames.relayout()   # its axes moved
             frames = {}
             for i in _drawing_order(explorer, states_settings, defaults, view):
                 frames[i] = _one_frame(explorer, states_settings[i], defaults, view, dpi)
@@ -251,6 +252,7 @@ def render_frames(explorer, states_settings: list[dict], *, column: bool) -> lis
         explorer.error = error
         explorer.apply(defaults)
         explorer.frames.reset()
+        explorer.frames.relayout()
 
 
 def explorer_data(explorer, *, column: bool, max_frames: int = MAX_FRAMES) -> dict:
