@@ -241,15 +241,13 @@ class Explorer:
         return self.alt_for(self.text)
 
     def alt_for(self, text: str, params: dict | None = None) -> str:
-        """The text alternative for the readout `text` and the settings `params` (default: the
-        controls' values; a static page gives those of each frame it stores)."""
+        """The text alternative for the readout `text` and the settings `params` (default: the controls')."""
         settings = ", ".join(f"{k} = {v:g}" if isinstance(v, (int, float)) else f"{k} = {v}"
                              for k, v in (self.params if params is None else params).items())
         return f"{self.title}. Settings: {settings}." + (f" {text}".replace("\n", "; ") if text else "")
 
     def apply(self, params: dict) -> None:
-        """Compute for the settings `params` and update the figure's artists (drawing is the
-        caller's; raises what `compute` raises). `refresh` does it for the controls' values."""
+        """Compute for the settings `params` and update the artists (not drawn; raises what compute raises)."""
         result = self._results(tuple(params.items()))   # a setting dragged over again: not recomputed
         self._update(self.handles, result)
         self.result = result

@@ -48,8 +48,7 @@ class FrameRenderer:
         self.full_draws = self.blits = 0
 
     def reset(self) -> None:
-        """Forget the background: the next frame is a full draw (with the layout kept unless the
-        text around the axes measures otherwise; `relayout` forgets it too)."""
+        """Forget the background: the next frame is a full draw (`relayout` forgets the layout)."""
         self._background = None
 
     def frame(self) -> bytes:
@@ -59,13 +58,11 @@ class FrameRenderer:
         return encode_png(self.canvas.buffer_rgba(), self.fig.dpi)
 
     def relayout(self) -> None:
-        """Make the next full draw lay the figure out anew, even when its text measures as before
-        (a static page stores each frame as a full draw at its settings would show it)."""
+        """Lay the figure out anew at the next full draw, even when its text measures as before."""
         self._layout = None
 
     def render(self) -> None:
-        """`frame` without the PNG: the canvas (``canvas.buffer_rgba()``) shows the figure as it is
-        now (the static pages encode it themselves, `coursekit.tools.static_explorers`)."""
+        """`frame` without the PNG: ``canvas.buffer_rgba()`` then shows the figure as it is now."""
         changed = {a for a in self._children() if a.stale} if self.full_draws else set()
         new = changed - self.moving
         self.moving |= changed

@@ -67,11 +67,8 @@ function render({ model, el }) {
     }
   }
   function schedule() { if (pending === null) pending = setTimeout(report, 150); }
-  // a slider's handle gets its label as its accessible name (ipywidgets leaves it unnamed), and
-  // every control keeps its keys: JupyterLab and Notebook 7 (Lumino) match no shortcut for a key
-  // pressed on an element marked data-lm-suppress-shortcuts, so an arrow key steps the slider
-  // instead of selecting the next cell or collapsing the section; the explorer is found once
-  // the view is in the page
+  // a slider's handle gets its label as its accessible name (ipywidgets leaves it unnamed); Lumino
+  // matches no shortcut on data-lm-suppress-shortcuts, so arrow keys step the slider, not the cells
   let explorer = null;
   function nameControls() {
     if (!explorer && (explorer = el.closest(".ck-explorer"))) {
@@ -84,9 +81,7 @@ function render({ model, el }) {
     }
     const keyed = '.ck-controls [role="slider"], .ck-controls select, .ck-controls input';
     for (const control of explorer?.querySelectorAll(keyed) || []) {
-      if (!control.hasAttribute("data-lm-suppress-shortcuts")) {
-        control.setAttribute("data-lm-suppress-shortcuts", "true");
-      }
+      control.setAttribute("data-lm-suppress-shortcuts", "true");
     }
   }
   const named = new MutationObserver(nameControls);
