@@ -11,39 +11,19 @@ wrong, what was received and what was expected, e.g.::
 from __future__ import annotations
 
 import sys as _sys
+import warnings
+from contextlib import contextmanager
 from typing import Callable
 
 import numpy as np
 
-from .diagnostics import UserFunctionError
+from .diagnostics import AccuracyWarning, UserFunctionError
 
-__all__ = [
-    "as_matrix",
-    "as_square",
-    "as_vector",
-    "as_series",
-    "as_scalar",
-    "as_time_grid",
-    "is_uniform",
-    "as_poles",
-    "as_covariance",
-    "as_integer",
-    "as_dt",
-    "as_text",
-    "as_flag",
-    "require_columns",
-    "time_grid",
-    "check_function_output",
-    "call_user",
-    "call_user_fast",
-    "checked_call",
-    "float_array",
-    "is_complex",
-    "is_text",
-    "foreign_library",
-    "type_name",
-    "BRIDGES",
-]
+__all__ = ["as_matrix", "as_square", "as_vector", "as_series", "as_scalar", "as_time_grid", "is_uniform",
+           "as_poles", "as_covariance", "as_integer", "as_dt", "as_text", "as_flag", "require_columns",
+           "time_grid", "check_function_output", "call_user", "call_user_fast", "checked_call", "float_array",
+           "is_complex", "is_text", "foreign_library", "type_name", "BRIDGES", "function_name",
+           "input_size_explained", "sympy_column", "warn_accuracy", "agrees_column_by_column"]
 
 
 def _describe(value) -> str:
@@ -527,3 +507,71 @@ def float_array(value, name: str) -> np.ndarray:
     except (TypeError, ValueError) as err:
         raise ValueError(f"{name} must be an array of real numbers: received {type(value).__name__} "
                          f"({err}).") from None
+
+
+def function_name(func: Callable, role: str = "f") -> str:
+    """How error messages name a user function: its role, and its own name if it has one."""
+    own = getattr(func, "__name__", "")
+    return f"{role} ({own})" if own and own not in (role, "<lambda>") else role
+
+
+@contextmanager
+def input_size_explained(u_eq, u: np.ndarray, task: str):
+    """Turn an IndexError of the user's f at the first call into "u_eq is missing / too short".
+
+    f(x, u) that reads u[0] fails with the student's own IndexError when u_eq
+    was left out (u is then empty); the message says which argument to pass.
+    """
+    try:
+        yield
+    except UserFunctionError as err:
+        if not isinstance(err.__cause__, IndexError):
+            raise
+        state = "is missing" if u_eq is None else f"may be too short ({u.size} entries)"
+        raise ValueError(
+            f"u_eq {state}: {err}. Pass {task} the input u* with one entry per input that f reads "
+            "(f uses u[0], u[1], ...), e.g. u_eq=[0.0]; if f reads no input, check that each state "
+            "has its entry in x."
+        ) from err
+
+
+def sympy_column(values, name: str, *, allow_empty: bool = False):
+    """`values` (a list or sympy Matrix of expressions) as a sympy column; text and (unless
+    `allow_empty`) an empty list raise ValueError naming `name`."""
+    import sympy as sp
+    texts = [values] if isinstance(values, str) else \
+        [v for v in values if isinstance(v, str)] if isinstance(values, (list, tuple)) else []
+    if texts:
+        raise ValueError(f"{name} must be a list of sympy expressions: received the text {texts[0]!r}; "
+                         "build expressions from symbols, e.g. x1, x2 = sp.symbols('x1 x2').")
+    try:
+        M = sp.Matrix(values)
+    except (TypeError, ValueError, NotImplementedError, sp.SympifyError):
+        raise ValueError(f"{name} must be a list of sympy expressions: received {values!r}.") from None
+    if len(M) == 0 and not allow_empty:
+        raise ValueError(f"{name} is empty: expected at least one expression, e.g. [x1, x2] "
+                         "from x1, x2 = sp.symbols('x1 x2').")
+    if min(M.shape) > 1:
+        raise ValueError(f"{name} must be a list (one row or one column): received a {M.shape[0]}x{M.shape[1]} "
+                         f"matrix; list the entries one after the other, e.g. [x1, x2, x3, x4].")
+    undefined = [v for v in (sp.nan, sp.zoo, sp.oo, -sp.oo) if M.has(v)]
+    if undefined:
+        raise ValueError(f"{name} contains {undefined[0]} (sympy's {'NaN' if undefined[0] is sp.nan else 'infinity'}): "
+                         f"received {list(M)!r}; look for a division by zero or a NaN where {name} "
+                         "was built, and pass finite expressions.")
+    if M.shape[1] != 1:
+        M = M.reshape(len(M), 1)
+    return M
+
+
+def warn_accuracy(message: str, *, stacklevel: int = 3) -> None:
+    """Issue an `AccuracyWarning` pointing at the caller of the public function."""
+    warnings.warn(message, AccuracyWarning, stacklevel=stacklevel)
+
+
+def agrees_column_by_column(fun, X: np.ndarray, U: np.ndarray, batch: np.ndarray) -> bool:
+    """True when `batch`, fun's answer for the states X and inputs U as columns, holds
+    fun(X[:, j], U[:, j]) in column j for every j (within 1e-12)."""
+    single = np.column_stack([np.ravel(fun(X[:, j], U[:, j])) for j in range(X.shape[1])])
+    return batch.size == single.size and np.allclose(batch.reshape(single.shape), single,
+                                                     rtol=1e-12, atol=1e-12)

@@ -18,12 +18,10 @@
 
 Every exception and warning class of coursekit is defined here, and this
 module imports nothing from coursekit, so every other module may import it.
-(Calling a user's function with this context is `_validation.call_user`.)
+(Calling a user's function with this context, and issuing a warning, is `_validation`.)
 """
 
 from __future__ import annotations
-
-import warnings
 
 __all__ = ["CoursekitWarning", "AccuracyWarning", "UserFunctionError", "SimulationError",
            "NotControllableError", "NotObservableError"]
@@ -60,6 +58,3 @@ class NotObservableError(ValueError):
     """Raised when an algorithm needs an observable pair (A, C) and it is not."""
 
 
-def warn_accuracy(message: str, *, stacklevel: int = 3) -> None:
-    """Issue an `AccuracyWarning` pointing at the caller of the public function (internal)."""
-    warnings.warn(message, AccuracyWarning, stacklevel=stacklevel)

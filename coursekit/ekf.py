@@ -13,13 +13,12 @@ from typing import Callable
 
 import numpy as np
 
+from ._derivatives import difference_quotients, numerical_jacobian, perturbed_states
 from ._filter_ode import checked_substeps, filter_setup, initial_estimate, records, run_filter
-from ._validation import call_user_fast
+from ._system_arg import as_system
+from ._validation import agrees_column_by_column, call_user_fast
 from .diagnostics import UserFunctionError
 from .kalman_bucy import KalmanResult
-from .linearization import numerical_jacobian, perturbed_states, difference_quotients
-from .simulation import agrees_column_by_column
-from .systems import as_system, raw_field, raw_output
 
 __all__ = ["extended_kalman_filter"]
 
@@ -61,6 +60,11 @@ def _accepts_batches(fun, x0: np.ndarray, u0: np.ndarray) -> bool:
         return agrees_column_by_column(fun, X, U, batch)
     except Exception:                   # written for one state at a time
         return False
+
+
+def _output_map(sys):
+    """The user's h(x, u), or y = x when the system has none."""
+    return sys.raw_output() or (lambda x, u: np.array(x, dtype=float))
 
 
 def _at(t: float) -> str:
@@ -124,7 +128,7 @@ def _ekf_model(sys, p: int, dfdx, dhdx, x0, u0):
             raise ValueError(f"{name} must be a function (x, u) -> Jacobian, or None for "
                              f"numerical differences: received {type(fun).__name__}.")
     n = sys.n
-    f_raw, h_raw = raw_field(sys), raw_output(sys)   # wrapped once, by _user, with the time
+    f_raw, h_raw = sys.raw_field(), _output_map(sys)   # wrapped once, by _user, with the time
     if dfdx is None and dhdx is None and _accepts_batches(f_raw, x0, u0) \
             and _accepts_batches(h_raw, x0, u0):
         return _batched_model(f_raw, h_raw, n)
@@ -161,9 +165,9 @@ def extended_kalman_filter(sys, t, u, y, Q, R, P0, x0, *, dfdx: Callable | None 
     sys = as_system(sys, kind="nonlinear", time="continuous", hint="for a StateSpace use kalman_bucy.")
     t, u, y = records(t, u, y, sys.m)
     x0 = initial_estimate(x0, sys.n)
-    _user(raw_field(sys), "f")(x0, u[0], t[0])
+    _user(sys.raw_field(), "f")(x0, u[0], t[0])
     sys.check(x0, u[0])
-    p_h = _user(raw_output(sys), "h")(x0, u[0], t[0]).size
+    p_h = _user(_output_map(sys), "h")(x0, u[0], t[0]).size
     if p_h != y.shape[1]:
         raise ValueError(f"y has the wrong number of columns: received {y.shape[1]}, expected "
                          f"{p_h} (the number of outputs of sys.h).")

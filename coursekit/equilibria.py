@@ -13,10 +13,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_dt, as_integer, as_matrix, as_scalar, as_vector, call_user, foreign_library
+from ._system_arg import as_system
+from ._validation import (as_dt, as_integer, as_matrix, as_scalar, as_vector, call_user, foreign_library,
+                          function_name, input_size_explained, sympy_column)
 from .diagnostics import UserFunctionError
-from .linearization import function_name, input_size_explained, sympy_column
-from .systems import NonlinearSystem, StateSpace, as_system, raw_field
+from .systems import NonlinearSystem, StateSpace
 
 __all__ = ["find_equilibria", "equilibrium_input", "symbolic_equilibria"]
 
@@ -26,7 +27,7 @@ def _field(f, n=None, dt=None):
     if foreign_library(f):
         f = as_system(f, "f")
     if isinstance(f, (NonlinearSystem, StateSpace)):
-        return raw_field(f), function_name(getattr(f, "_f", f.f)), f.n, f.m, f.dt
+        return f.raw_field(), function_name(f.raw_field()), f.n, f.m, f.dt
     if not callable(f):
         raise ValueError(
             f"f must be a NonlinearSystem or a function f(x, u) returning dx/dt: received "

@@ -28,10 +28,11 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import as_flag, as_matrix, as_scalar, as_vector, float_array
-from .controllability import as_pair, ccf_transform, charpoly
-from .diagnostics import warn_accuracy
-from .trajectory import PLAN_RTOL, input_time, plan_grid, plot_plan, poly_trajectory
+from ._pairs import as_pair
+from ._plans import PLAN_RTOL, input_time, plan_grid
+from ._validation import as_flag, as_matrix, as_scalar, as_vector, float_array, warn_accuracy
+from .controllability import ccf_transform, charpoly
+from .trajectory import plot_plan, poly_trajectory
 
 __all__ = [
     "FlatSystem",
@@ -349,7 +350,7 @@ class FlatPlan:
         """``u(t, x)`` for `simulate`: open loop, x is ignored (t is clipped to [0, T])."""
         tt = input_time(t, self.horizon)
         # the same maps as u(t), without re-checking the inputs at every solver step
-        columns = [traj._scalar_derivatives(tt, self.flat.order_u) for traj in self.trajectories]
+        columns = [traj.derivatives(tt, self.flat.order_u) for traj in self.trajectories]
         D = [np.array([[col[k] for col in columns]]) for k in range(self.flat.order_u + 1)]
         return self.flat._psi_u(D)[0]
 

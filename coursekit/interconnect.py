@@ -9,8 +9,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._system_arg import as_system
 from ._validation import as_scalar
-from .systems import StateSpace, as_system
+from .systems import StateSpace
 
 __all__ = ["cascade", "feedback"]
 

@@ -35,9 +35,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._validation import as_covariance, as_dt
-from .diagnostics import warn_accuracy
-from .observability import as_obs_pair
+from ._pairs import as_obs_pair
+from ._validation import as_covariance, as_dt, warn_accuracy
 
 __all__ = ["kalman_gain"]
 

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._filter_ode import advance, all_finite, checked_substeps, diverged, filter_setup, next_step, records
-from .systems import as_system
+from ._system_arg import as_system
 
 __all__ = ["kalman_bucy", "KalmanResult"]
 

@@ -28,9 +28,10 @@ from __future__ import annotations
 import numpy as np
 
 from ._filter_ode import initial_estimate
+from ._system_arg import as_system
 from ._validation import as_covariance, as_series
 from .kalman_bucy import KalmanResult
-from .systems import StateSpace, as_system
+from .systems import StateSpace
 
 __all__ = ["discrete_kalman_filter"]
 

@@ -16,9 +16,11 @@ from __future__ import annotations
 import numpy as np
 
 from ._filter_ode import records
+from ._stepping import check_finite, step_matrices
+from ._system_arg import as_system
 from ._validation import as_covariance, as_scalar, as_square, as_time_grid, as_vector, is_uniform
-from .simulation import SimulationResult, _check_finite, _step_matrices
-from .systems import StateSpace, as_system
+from .simulation import SimulationResult
+from .systems import StateSpace
 
 __all__ = ["white_noise", "simulate_with_noise", "van_loan"]
 
@@ -117,12 +119,12 @@ def simulate_with_noise(sys, t, u=None, x0=None, *, Q, R, seed=None) -> Simulati
     x = np.empty((N, n))
     x[0] = x0
     if isinstance(sys, StateSpace):
-        Ad, B0, B1 = _step_matrices(sys.A, sys.B, dt)   # checked by StateSpace (B may have no columns)
+        Ad, B0, B1 = step_matrices(sys.A, sys.B, dt)   # checked by StateSpace (B may have no columns)
         # white_noise samples have covariance intensity / dt, so intensity Qd dt gives Qd
         w = white_noise(t, _van_loan(sys.A, Q, dt)[1] * dt, rng)
         # everything but Ad x(k), for all k at once: B0 u(k) + B1 u(k+1) + w(k)
         forcing = u[:-1] @ B0.T + u[1:] @ B1.T + w[:-1]
-        with np.errstate(over="ignore", invalid="ignore"):   # explained by _check_finite below
+        with np.errstate(over="ignore", invalid="ignore"):   # explained by check_finite below
             for k in range(N - 1):
                 x[k + 1] = Ad @ x[k] + forcing[k]
     else:
@@ -131,7 +133,7 @@ def simulate_with_noise(sys, t, u=None, x0=None, *, Q, R, seed=None) -> Simulati
         for k in range(N - 1):
             x[k + 1] = _rk4_held(sys.f, x[k], u[k], u[k + 1], w[k], dt)
     # an unstable system leaves the float range: the error of simulate, with the time and the rate
-    _check_finite(sys, t, x)
+    check_finite(sys, t, x)
     if isinstance(sys, StateSpace):
         y_clean = x @ sys.C.T + u @ sys.D.T                 # y = C x + D u at every sample
     else:

@@ -4,7 +4,7 @@ observer gains by pole placement (4.46, 4.60, 4.84).
 Observability is the dual of controllability: (A, C) is observable exactly
 when (A^T, C^T) is controllable, since the observability matrix Wo of (4.15)
 is the transpose of the controllability matrix of (A^T, C^T). This module
-therefore reuses the helpers of `controllability` and `placement` instead
+therefore reuses the helpers of `_pairs` and `_pole_placement` instead
 of repeating them.
 
 * `obsv(A, C)` builds Wo = [C; CA; ...; CA^(n-1)] (4.12), (4.15);
@@ -12,8 +12,6 @@ of repeating them.
   units by duality with `is_controllable`;
 * `ocf_transform(A, C)` returns T with z = T x in OCF (4.31)-(4.32);
 * `place_observer(A, C, poles)` returns L with eig(A - L C) = poles.
-
-Shared within coursekit (not in ``ck.*``): `as_obs_pair` checks (A, C) for `kalman_gain`.
 """
 
 from __future__ import annotations
@@ -22,32 +20,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import as_matrix, as_poles, as_square
+from ._pairs import (Staircase, as_obs_pair, canonical_transform, check_tol, ctrb_unchecked, marginal_note,
+                     unit_free_staircase)
+from ._pole_placement import PoleMatch, check_size, place_gain, require_finite, warn_if_missed
+from ._validation import as_poles
+from .controllability import charpoly
 from .diagnostics import NotObservableError
-from .controllability import (canonical_transform, charpoly, check_tol, unit_free_staircase, ctrb_unchecked,
-                              marginal_note, Staircase)
-from .placement import place_gain, PoleMatch, require_finite, warn_if_missed, check_size, poly_from_roots
+from .placement import poly_from_roots
 
-__all__ = [
-    "obsv",
-    "obsv_singular_values",
-    "is_observable",
-    "ocf_transform",
-    "place_observer",
-    "place_observer_details",
-    "ObserverDetails",
-]
-
-
-def as_obs_pair(A, C):
-    """Validate (A, C): A square (n, n), C of shape (p, n); a 1-D C is one row."""
-    A = as_square(A, "A")
-    n = A.shape[0]
-    C = as_matrix(C, "C", cols=n, cols_why=f"one per state, since A is {n}x{n}",
-                  rows=1 if np.ndim(C) == 1 else None)
-    if C.shape[0] == 0:
-        raise ValueError("C has no rows: the system has no measurement to estimate the state from.")
-    return A, C
+__all__ = ["obsv", "obsv_singular_values", "is_observable", "ocf_transform", "place_observer",
+           "place_observer_details", "ObserverDetails"]
 
 
 def _obsv(A: np.ndarray, C: np.ndarray) -> np.ndarray:

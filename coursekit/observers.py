@@ -21,8 +21,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._system_arg import as_system
 from ._validation import as_matrix, as_series
-from .systems import StateSpace, as_system
+from .systems import StateSpace
 
 __all__ = [
     "observer_system",

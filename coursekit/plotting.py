@@ -12,9 +12,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._figure_arg import figure_for
 from ._validation import as_integer, as_matrix, as_text
-from .simulation import SimulationResult
-from .style import curve_style, figure_for, new_figure, text_colour
+from .style import curve_style, new_figure, text_colour
 
 __all__ = ["plot_response", "plot_state_plane", "plot_euler_comparison"]
 
@@ -49,8 +49,13 @@ def _units(given, count: int, argname: str) -> list[str]:
     return units
 
 
-def _check_result(result, argname: str = "result") -> SimulationResult:
-    if not isinstance(result, SimulationResult):
+def _is_result(value) -> bool:
+    """True for a `SimulationResult` (read by its fields: `simulation` imports this module)."""
+    return all(hasattr(value, name) for name in ("t", "x", "y", "u", "system"))
+
+
+def _check_result(result, argname: str = "result"):
+    if not _is_result(result):
         raise ValueError(
             f"{argname} must be a SimulationResult (what simulate returns): received "
             f"{type(result).__name__}."
@@ -155,7 +160,7 @@ def _trajectory_list(trajectories, states) -> list[tuple[np.ndarray, bool]]:
     items = trajectories if isinstance(trajectories, (list, tuple)) else [trajectories]
     out = []
     for k, item in enumerate(items):
-        if isinstance(item, SimulationResult):
+        if _is_result(item):
             data, discrete = item.x, item.system.is_discrete
         else:
             if np.ndim(item) != 2:

@@ -15,8 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._system_arg import as_system
 from ._validation import as_scalar, as_vector
-from .systems import NonlinearSystem, StateSpace, as_system
+from .systems import NonlinearSystem, StateSpace
 
 __all__ = ["ode_to_ss", "difference_to_ss", "euler_discretize"]
 

@@ -33,10 +33,12 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ._validation import (as_matrix, as_scalar, as_series, as_square, as_time_grid, as_vector, call_user,
-                          checked_call, is_uniform, require_columns)
+from ._stepping import check_finite, overflow_error, step_matrices
+from ._system_arg import as_system
+from ._validation import (agrees_column_by_column, as_matrix, as_scalar, as_series, as_square, as_time_grid,
+                          as_vector, call_user, checked_call, is_uniform, require_columns)
 from .diagnostics import SimulationError, UserFunctionError
-from .systems import NonlinearSystem, StateSpace, as_system, raw_field
+from .systems import NonlinearSystem, StateSpace
 
 __all__ = ["simulate", "simulate_batch", "SimulationResult", "lti_step_matrices"]
 
@@ -150,7 +152,7 @@ def simulate(sys, t, u=None, x0=None, *, rtol: float = 1e-9, atol: float = 1e-12
         else:
             x = _integrate(model, t, x0, options)
             u_arr = _inputs_on_grid(model, t, x)
-    _check_finite(sys, t, x, feedback=u_user is not None)
+    check_finite(sys, t, x, feedback=u_user is not None)
     return SimulationResult(t=t, x=x, y=_outputs(sys, t, x, u_arr), u=u_arr, system=sys)
 
 
@@ -201,7 +203,7 @@ def simulate_batch(sys, t, x0s, u=None, *, rtol: float = 1e-9, atol: float = 1e-
     _check_batch(model, t[0], X0.T)
     with np.errstate(over="ignore"):   # the SimulationError explains an overflow
         x = _integrate_batch(model, t, X0.T, options)
-    _check_finite(sys, t, x.reshape(t.size, n * k), feedback=u is not None)
+    check_finite(sys, t, x.reshape(t.size, n * k), feedback=u is not None)
     return x.reshape(t.size, n, k).transpose(0, 2, 1)
 
 
@@ -267,14 +269,6 @@ def _batch_input(u, tk: float, X: np.ndarray, m: int) -> np.ndarray:
         raise ValueError(f"u returned shape {U.shape} for a batch X of shape {X.shape}; "
                          f"expected ({m}, {X.shape[1]}), one column per initial state.")
     return U
-
-
-def agrees_column_by_column(fun, X: np.ndarray, U: np.ndarray, batch: np.ndarray) -> bool:
-    """(Shared with the EKF.) True when `batch`, fun's answer for the states X and inputs U as columns, holds
-    fun(X[:, j], U[:, j]) in column j for every j (within 1e-12)."""
-    single = np.column_stack([np.ravel(fun(X[:, j], U[:, j])) for j in range(X.shape[1])])
-    return batch.size == single.size and np.allclose(batch.reshape(single.shape), single,
-                                                     rtol=1e-12, atol=1e-12)
 
 
 def _solver_options(rtol, atol, method, n: int, copies: int = 1) -> dict:
@@ -346,7 +340,7 @@ class _Model:
 
     def __init__(self, sys, u_fun, u_user=None):
         self.sys, self.u_fun, self.u_user = sys, u_fun, u_user
-        self.f = raw_field(sys)
+        self.f = sys.raw_field()
 
     def input(self, tk, xk) -> np.ndarray:
         """u(t, x), finite."""
@@ -421,14 +415,14 @@ class _Model:
             pass
         self._check_range(tk, xk)
         if isinstance(self.sys, StateSpace):
-            raise _overflow(self.sys, f"A x + B u left it {where}", feedback=self.u_user is not None)
+            raise overflow_error(self.sys, f"A x + B u left it {where}", feedback=self.u_user is not None)
         self.sys.check(xk, uk, where=where)
 
     def _check_range(self, tk, xk) -> None:
-        """Raise `_overflow` when the state is not finite or beyond `_HUGE`: then the
+        """Raise `overflow_error` when the state is not finite or beyond `_HUGE`: then the
         failure is the state's growth, whatever u or f make of such a state."""
         if _out_of_range(xk):
-            raise _overflow(self.sys, f"the state reached {np.array2string(np.asarray(xk), precision=3)} "
+            raise overflow_error(self.sys, f"the state reached {np.array2string(np.asarray(xk), precision=3)} "
                             f"at t = {tk:.6g}", feedback=self.u_user is not None)
 
 
@@ -444,55 +438,12 @@ def _screen(a: np.ndarray) -> bool:
     return math.isfinite(sum(a.reshape(-1).tolist()) if a.size <= 64 else a.sum())
 
 
-def _overflow(sys, what: str, *, feedback: bool = False) -> SimulationError:
-    """The error for a state beyond the float range: when, why, and what to try."""
-    return SimulationError(
-        f"the simulation left the float range (about 1.8e308): {what}. {_growth(sys, feedback)} "
-        "To see the growth, simulate a shorter time (stop before this time) or plot |x| on a "
-        "log scale; to keep the state bounded, stabilize the system (chapter 3)."
-    )
-
-
-def _growth(sys, feedback: bool = False) -> str:
-    """Why the state grows: for a StateSpace, the eigenvalues of A (section 3.2.2)."""
-    if not isinstance(sys, StateSpace):
-        return ("The solution grows without bound: it runs away from an unstable equilibrium, "
-                "or has a finite escape time (as x' = x^2 does).")
-    lam = np.linalg.eigvals(sys.A)
-    of_a = ("of A alone (your input u(t, x) changes the dynamics: for u = K x look at the "
-            "eigenvalues of A + B K)" if feedback else "of A")
-    if sys.is_discrete:
-        rho = float(np.abs(lam).max())
-        verdict = (f"> 1: the system is unstable and |x| grows like {rho:.4g}^k, passing 1e308 "
-                   f"within about {709.8 / np.log(rho):.4g} steps") if rho > 1 else \
-            "<= 1: the growth comes from the input"
-        return f"The spectral radius (largest |eigenvalue|) {of_a} is {rho:.4g} {verdict}."
-    a = float(lam.real.max())
-    verdict = (f"> 0: the system is unstable (section 3.2.2) and |x| grows like e^({a:.4g} t), "
-               f"passing 1e308 within about {709.8 / a:.4g} time units") if a > 0 else \
-        "<= 0: the growth comes from the input"
-    return f"The largest real part of the eigenvalues {of_a} is {a:.4g} {verdict}."
-
-
-def _check_finite(sys, t: np.ndarray, x: np.ndarray, *, feedback: bool = False) -> None:
-    """Raise `_overflow` at the first sample where x (N, ...) is not finite."""
-    with np.errstate(over="ignore"):   # a sum of large finite entries may overflow: settled below
-        if math.isfinite(x.sum()):     # the cheap screen of `_screen`
-            return
-    bad = ~np.isfinite(x.reshape(t.size, -1)).all(axis=1)
-    if bad.any():
-        k = max(int(np.argmax(bad)), 1)
-        raise _overflow(sys, f"the state is finite up to t = {t[k - 1]:.6g} (largest |x| = "
-                        f"{np.abs(x[k - 1]).max():.3g}) and overflows by t = {t[k]:.6g}",
-                        feedback=feedback)
-
-
 def _solver_failure(sys, sol, last: list) -> SimulationError:
     """The error for solve_ivp stopping early; `last` is the (t, x) of its last
     evaluation of f (a trial step, so x is only shown when it has overflowed)."""
     tk, xk = last
     if _out_of_range(xk):
-        return _overflow(sys, f"the state reached {np.array2string(np.asarray(xk), precision=3)} "
+        return overflow_error(sys, f"the state reached {np.array2string(np.asarray(xk), precision=3)} "
                          f"at t = {tk:.6g}")
     reached = (f"the last sample it reached is t = {sol.t[-1]:.6g}, x = "
                f"{np.array2string(sol.y[:, -1], precision=4)}" if np.size(sol.t) else
@@ -572,35 +523,13 @@ def lti_step_matrices(A, B, h):
     B = as_matrix(B, "B", rows=n, rows_why=f"one per state, since A is {n}x{n}",
                   cols=1 if np.ndim(B) == 1 else None)
     require_columns(B.shape, "B")
-    return _step_matrices(A, B, as_scalar(h, "h", positive=True))
-
-
-def _step_matrices(A: np.ndarray, B: np.ndarray, h: float):
-    """`lti_step_matrices` for checked arguments."""
-    from scipy.linalg import expm
-    n, m = B.shape
-    # The input blocks are linear in B: a B far larger than A h (B scaled by 1e200) would make
-    # expm square many more times and spoil Ad = e^(A h); B is brought to A h's size by a power
-    # of two (exact), and the blocks scaled back.
-    with np.errstate(over="ignore"):
-        ratio = float(np.abs(B).max(initial=0.0)) * h / max(1.0, float(np.abs(A).max(initial=0.0)) * h)
-    scale = 2.0 ** np.ceil(np.log2(ratio)) if ratio > 1.0 and np.isfinite(ratio) else 1.0
-    M = np.zeros((n + 2 * m, n + 2 * m))
-    M[:n, :n] = A * h
-    M[:n, n:n + m] = (B / scale) * h
-    M[n:n + m, n + m:] = np.eye(m)
-    with np.errstate(over="ignore", invalid="ignore"):   # an overflow is raised just below
-        E = expm(M)
-        Ad, G0, G1 = E[:n, :n], E[:n, n:n + m] * scale, E[:n, n + m:] * scale
-    if not (np.isfinite(Ad).all() and np.isfinite(G0).all() and np.isfinite(G1).all()):
-        raise _overflow(StateSpace(A), f"e^(A h) over one step h = {h:g} is already beyond it")
-    return Ad, G0 - G1, G1
+    return step_matrices(A, B, as_scalar(h, "h", positive=True))
 
 
 def _lti_exact(sys: StateSpace, t: np.ndarray, x0: np.ndarray, u: np.ndarray) -> np.ndarray:
     """Exact response of a continuous LTI system to a piecewise-linear input."""
     if is_uniform(t):
-        Ad, B0, B1 = _step_matrices(sys.A, sys.B, t[1] - t[0])
+        Ad, B0, B1 = step_matrices(sys.A, sys.B, t[1] - t[0])
         return _recurse(Ad, x0, [(B0, u[:-1]), (B1, u[1:])])
     x = np.empty((t.size, sys.n))
     x[0] = x0
@@ -608,7 +537,7 @@ def _lti_exact(sys: StateSpace, t: np.ndarray, x0: np.ndarray, u: np.ndarray) ->
     for k, h in enumerate(np.diff(t)):
         key = round(float(h), 12)
         if key not in cache:
-            cache[key] = _step_matrices(sys.A, sys.B, h)
+            cache[key] = step_matrices(sys.A, sys.B, h)
         Ad, B0, B1 = cache[key]
         x[k + 1] = Ad @ x[k] + B0 @ u[k] + B1 @ u[k + 1]
     return x
@@ -769,7 +698,7 @@ _RECHECK_EVERY = 10_000
 
 def _fastest_rate(field, x: np.ndarray) -> float:
     """|lambda|max of the Jacobian of `field` at x; NaN when it cannot be estimated there."""
-    from .linearization import numerical_jacobian
+    from ._derivatives import numerical_jacobian
     try:
         with np.errstate(all="ignore"):
             J = numerical_jacobian(field, x, refine=False)
@@ -876,11 +805,11 @@ def _outputs(sys, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> np.ndarray:
     end (`_output_failure` explains the first bad sample)."""
     if isinstance(sys, StateSpace):
         y = x @ sys.C.T + u @ sys.D.T
-        _check_finite(sys, t, y)
+        check_finite(sys, t, y)
         return y
-    if sys._h is None:
+    h, rows = sys.raw_output(), []
+    if h is None:
         return x.copy()
-    h, rows = sys._h, []
     try:
         for xk, uk in zip(x, u):
             rows.append(np.asarray(h(xk, uk), dtype=float).reshape(-1))
@@ -898,7 +827,7 @@ def _outputs(sys, t: np.ndarray, x: np.ndarray, u: np.ndarray) -> np.ndarray:
 def _output_failure(sys, tk, xk, uk, size) -> None:
     """Raise the error that explains why h fails at time tk, if it does (call_user's wording)."""
     where = _where(tk, xk)
-    value = call_user(sys._h, (xk, uk), "h", where=where)
+    value = call_user(sys.raw_output(), (xk, uk), "h", where=where)
     if size is not None and value.size != size:
         raise UserFunctionError(f"h returned {value.size} numbers {where}, but {size} at the start; "
                                 "h must return the same number of outputs at every time.")

@@ -14,8 +14,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._system_arg import as_system
 from ._validation import as_dt, as_square, foreign_library
-from .systems import StateSpace, as_system
+from .systems import StateSpace
 
 __all__ = ["is_stable", "plot_poles", "format_poles"]
 
@@ -94,7 +95,8 @@ def plot_poles(poles, *, dt=None, ax=None, title: str | None = None):
     """
     sets = _as_pole_sets(poles)
     dt = as_dt(dt)
-    from .style import PALETTE, curve_style, figure_for
+    from ._figure_arg import figure_for
+    from .style import PALETTE, curve_style
     fig, ax = figure_for(ax)
     green = PALETTE["bluish green"]
     everything = np.concatenate(list(sets.values()))

@@ -6,21 +6,18 @@
 of (1.33). Both expose `f(x, u)` and `h(x, u)` so that `simulate` treats
 them alike.
 
-Shared within coursekit (not in ``ck.*``): `as_system` (every public function
-that takes a system calls it: python-control and scipy.signal systems are
-converted through the bridges), and `raw_field` / `raw_output`, the model's own
-f and h for hot loops.
+`raw_field()` and `raw_output()` give the model's own f and h, without the checks, for
+hot loops. A function that takes a system checks it with `_system_arg.as_system`.
 """
 
 from __future__ import annotations
 
-import sys as _sys
 from typing import Callable
 
 import numpy as np
 
-from ._validation import (BRIDGES, as_dt, as_matrix, as_scalar, as_square, call_user, call_user_fast, checked_call,
-                          float_array, foreign_library, type_name)
+from ._validation import (as_dt, as_matrix, as_scalar, as_square, call_user, call_user_fast, checked_call,
+                          float_array)
 
 __all__ = ["StateSpace", "NonlinearSystem"]
 
@@ -67,27 +64,6 @@ def _at(x: np.ndarray, u: np.ndarray) -> str:
 def _evaluate(func: Callable, x: np.ndarray, u: np.ndarray, name: str) -> np.ndarray:
     """func(x, u) as a float array; a failure is explained naming `name` and the point (x, u)."""
     return call_user_fast(func, (x, u), name, where=lambda: _at(x, u))
-
-
-def raw_field(sys) -> Callable:
-    """The model's own f(x, u), without the argument checks and the wrapping of `sys.f`.
-
-    For hot loops (`simulate`) and for callers that call it through
-    `call_user` with context of their own ("at t = 0.4"); calling `sys.f`
-    there would wrap an already explained `UserFunctionError` once more.
-    """
-    if isinstance(sys, StateSpace):
-        A, B = sys.A, sys.B
-        return lambda x, u: A @ x + B @ u
-    return sys._f
-
-
-def raw_output(sys) -> Callable:
-    """The model's own h(x, u) (C x + D u, or x when h is not given), as `raw_field` for f."""
-    if isinstance(sys, StateSpace):
-        C, D = sys.C, sys.D
-        return lambda x, u: C @ x + D @ u
-    return sys._h or (lambda x, u: np.array(x, dtype=float))
 
 
 class StateSpace:
@@ -184,6 +160,16 @@ class StateSpace:
         """Eigenvalues of A, i.e. the poles of the system (section 3.2)."""
         return np.linalg.eigvals(self.A)
 
+    def raw_field(self) -> Callable:
+        """f(x, u) = A x + B u (1.24) without the argument checks of `f`, for hot loops."""
+        A, B = self.A, self.B
+        return lambda x, u: A @ x + B @ u
+
+    def raw_output(self) -> Callable:
+        """h(x, u) = C x + D u (1.24) without the argument checks of `h`, for hot loops."""
+        C, D = self.C, self.D
+        return lambda x, u: C @ x + D @ u
+
     def __repr__(self) -> str:
         kind = "continuous" if self.dt is None else f"discrete, dt={self.dt:g}"
         title = f" {self.name!r}" if self.name else ""
@@ -195,28 +181,28 @@ class StateSpace:
                 parts.append(f"  {label} = {body}")
         return "\n".join(parts)
 
-    # Bridges to python-control and SciPy (coursekit/bridges.py): exact copies of A, B, C, D, dt.
+    # Bridges to python-control and SciPy (coursekit/_bridges.py): exact copies of A, B, C, D, dt.
 
     @classmethod
     def from_control(cls, sys) -> "StateSpace":
         """The python-control ``StateSpace`` `sys` as a coursekit StateSpace (dt=0 -> continuous)."""
-        from .bridges import from_control
+        from ._bridges import from_control
         return from_control(sys, cls)
 
     def to_control(self):
         """This system as a python-control ``StateSpace`` (continuous -> dt=0; needs `pip install control`)."""
-        from .bridges import to_control
+        from ._bridges import to_control
         return to_control(self)
 
     @classmethod
     def from_scipy(cls, sys) -> "StateSpace":
         """The ``scipy.signal.StateSpace`` `sys` (continuous or discrete) as a coursekit StateSpace."""
-        from .bridges import from_scipy
+        from ._bridges import from_scipy
         return from_scipy(sys, cls)
 
     def to_scipy(self):
         """This system as a ``scipy.signal.StateSpace`` (continuous: dt=None; discrete: its dt)."""
-        from .bridges import to_scipy
+        from ._bridges import to_scipy
         return to_scipy(self)
 
 
@@ -297,6 +283,18 @@ class NonlinearSystem:
         if self._h is not None:
             call_user(self._h, (x, u), "h", where=where)
 
+    def raw_field(self) -> Callable:
+        """The user's own f(x, u), without the checks and the error wrapping of `f`.
+
+        For hot loops (`simulate`) and for callers that call it with context of their own
+        ("at t = 0.4"), where `f` would wrap an already explained `UserFunctionError` again.
+        """
+        return self._f
+
+    def raw_output(self) -> Callable | None:
+        """The user's own h(x, u) as `raw_field` gives f, or None when y = x (no h given)."""
+        return self._h
+
     def __repr__(self) -> str:
         kind = "continuous" if self.dt is None else f"discrete, dt={self.dt:g}"
         title = f" {self.name!r}" if self.name else ""
@@ -305,60 +303,3 @@ class NonlinearSystem:
         return f"NonlinearSystem{title}: n={self.n}, m={self.m} ({kind})" + (f"; {extra}" if extra else "")
 
 
-_KINDS = {"any": "StateSpace or NonlinearSystem", "linear": "StateSpace", "nonlinear": "NonlinearSystem"}
-
-
-def _system_received(value) -> str:
-    """How a refused system argument is described: its time base, or its full type name."""
-    if isinstance(value, np.ndarray):
-        return f"a numpy array of shape {value.shape}"
-    if hasattr(value, "is_discrete") and type(value).__module__ == "coursekit.systems":
-        base, period = ("discrete", f" (dt={value.dt:g})") if value.is_discrete else ("continuous", "")
-        return f"a {base}-time {type(value).__name__}{period}"
-    return type_name(value)
-
-
-def as_system(value, name: str = "sys", *, kind: str = "any", time: str = "", hint: str = ""):
-    """Return `value` as a coursekit system, converting python-control and scipy.signal ones.
-
-    `kind` is "any" (StateSpace or NonlinearSystem), "linear" (StateSpace) or
-    "nonlinear"; `time` is "", "continuous" or "discrete". A ``control.StateSpace``
-    or ``scipy.signal.StateSpace`` (also ``scipy.signal.lti(A, B, C, D)``) goes through
-    the bridges `StateSpace.from_control` / `from_scipy` (the same matrices (1.24) and
-    time base); one whose time base is unspecified (``dt=True``, or python-control's
-    ``dt=None``) is refused, because reading it as dt = 1 or as continuous is the user's
-    choice, and so is choosing the realization of a transfer function: both messages
-    name the bridge. Anything else raises ValueError naming `name`, the wanted kind and
-    the full type name of what was received, followed by `hint`.
-    """
-    library = foreign_library(value)
-    if library is not None:
-        value = _from_foreign(value, name, library)
-    wanted = (StateSpace, NonlinearSystem) if kind == "any" else \
-        StateSpace if kind == "linear" else NonlinearSystem
-    right_time = not time or isinstance(value, (StateSpace, NonlinearSystem)) and \
-        value.is_discrete == (time == "discrete")
-    if not isinstance(value, wanted) or not right_time:
-        base = f"{time}-time " if time else ""
-        raise ValueError(f"{name} must be a {base}{_KINDS[kind]}: received {_system_received(value)}"
-                         + (f"; {hint}" if hint else "."))
-    return value
-
-
-def _from_foreign(value, name: str, library: str):
-    """The coursekit StateSpace of a python-control / scipy.signal state-space object (bridges)."""
-    from .bridges import realization_hint
-    module = _sys.modules["control" if library == "python-control" else "scipy.signal"]
-    bridge = BRIDGES[library]
-    if not isinstance(value, module.StateSpace):
-        raise ValueError(f"{name} must be a state-space system: received {type_name(value)}. "
-                         f"{realization_hint(value)} Then convert it with {bridge}(sys).")
-    dt = value.dt
-    if dt is True or (dt is None and library == "python-control"):
-        raise ValueError(
-            f"{name} is a {library} system whose time base is unspecified (dt={dt!r}): "
-            f"convert it with {bridge}(sys), which reads dt=True as a period of 1 and "
-            "python-control's dt=None as continuous time, or build it with dt=0 (continuous) "
-            "or the sampling period."
-        )
-    return getattr(StateSpace, bridge.split(".")[1])(value)

@@ -26,10 +26,11 @@ from typing import Callable
 
 import numpy as np
 
-from ._validation import (as_integer, as_scalar, as_series, as_time_grid, as_vector, call_user,
-                          require_columns, time_grid)
-from .controllability import as_pair, ccf_transform, charpoly
-from .diagnostics import warn_accuracy
+from ._pairs import as_pair
+from ._plans import PLAN_RTOL, input_time, plan_grid
+from ._validation import (as_integer, as_scalar, as_series, as_time_grid, as_vector, call_user, require_columns,
+                          warn_accuracy)
+from .controllability import ccf_transform, charpoly
 
 __all__ = ["PolyTrajectory", "poly_trajectory", "feedforward", "OpenLoopPlan", "open_loop_control",
            "plot_plan"]
@@ -38,20 +39,6 @@ __all__ = ["PolyTrajectory", "poly_trajectory", "feedforward", "OpenLoopPlan", "
 def _times(t, name: str = "t"):
     """Return (times as a 1-D array, whether the input was a single number)."""
     return as_vector(t, name), np.ndim(t) == 0
-
-
-def input_time(t, horizon: float) -> float:
-    """One time for a plan's ``input(t, x)``, clipped to [0, T]; checked unless a finite float.
-
-    An ODE solver passes a finite float at every step, so that case skips the checks.
-    """
-    tt = t if isinstance(t, float) and isfinite(t) else as_scalar(t, "t")
-    return min(max(tt, 0.0), horizon)
-
-
-def plan_grid(horizon: float, samples) -> np.ndarray:
-    """The plot grid of a plan: `samples` (>= 2) times on [0, T]."""
-    return time_grid(horizon, samples, t_end_name="T", max_span=None)
 
 
 def _derivative_order(k) -> int:
@@ -163,7 +150,7 @@ class PolyTrajectory:
             rows = np.arange(N + 1)[:, None] + np.arange(N + 1)[None, :]
             self._table = np.where(rows <= N, C[:, np.minimum(rows, N)], 0.0) * _falling(N)
             self._inv_powers = T ** -np.arange(N + 1, dtype=float)
-        # plain-float copies of the table, one centre at a time, for `_scalar_derivatives`
+        # plain-float copies of the table, one centre at a time, for `derivatives`
         self._rows = [None] * (_CENTRES + 1)
         self._inv = self._inv_powers.tolist()
 
@@ -181,13 +168,14 @@ class PolyTrajectory:
     def __call__(self, t, k=0):
         if isinstance(t, float) and isfinite(t) and type(k) is int and k >= 0:
             # one finite time, as an ODE solver asks at every step: skip the array checks
-            return self._scalar_derivatives(t, k)[k]
+            return self.derivatives(t, k)[k]
         tt, scalar = _times(t)
         values = self._eval(tt, _derivative_order(k))
         return float(values[0]) if scalar else values
 
-    def _scalar_derivatives(self, t: float, order: int) -> list:
-        """[y, y', ..., y^(order)] at one time t, in plain floats (fast path for ODE solvers)."""
+    def derivatives(self, t: float, order: int) -> list:
+        """[y, y', ..., y^(order)] at one finite time t (a float), in plain floats, unchecked:
+        the fast path for ODE solvers and for the flat outputs' derivatives (2.88)."""
         tau = t / self.T
         q = min(max(round(tau * _CENTRES), 0), _CENTRES)
         h = tau - q / _CENTRES
@@ -446,7 +434,7 @@ class OpenLoopPlan:
         u_d^(k) = y_d^(n+k) + a_0 y_d^(k) + ... + a_{n-1} y_d^(n-1+k).
         """
         n = self.n
-        y = self.yd._scalar_derivatives(t, n + count - 1)
+        y = self.yd.derivatives(t, n + count - 1)
         out = []
         for k in range(count):
             total = y[n + k]
@@ -492,14 +480,6 @@ def plot_plan(t, x, u, *, title: str):
         ax.legend()
     fig.suptitle(title, wrap=True)
     return fig
-
-
-# A plan counts as landing when its own x(0), x(T) and the simulated x(T) are within 1e-6 of
-# the task's size max(|x0|, |xT|). Rounding moves them by ~1e-15 of the largest state on the
-# way, so this holds while the plan stays within ~1e8 times the task's size (the notes'
-# examples: < 10; random 8-state systems with T = 1: ~1e6); 12 random states pass 1e10.
-#: relative tolerance of an open-loop plan's boundary check (shared with `flatness`)
-PLAN_RTOL = 1e-6
 
 
 def _landing(plan: OpenLoopPlan) -> np.ndarray:

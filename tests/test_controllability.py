@@ -95,7 +95,7 @@ def test_ccf_transform_follows_a_change_of_units(n, seed, log_a, log_d):
 
 def test_ccf_transform_warns_when_its_result_misses_the_ccf(monkeypatch):
     # a deliberate mistake: perturb T_1 by 1e-6 after it has been computed
-    import coursekit.controllability as cm
+    import coursekit._pairs as cm
     rows = cm._ccf_rows
     monkeypatch.setattr(cm, "_ccf_rows", lambda v: rows(v) * (1 + 1e-6 * np.eye(len(v.Q))[0][:, None]))
     with pytest.warns(ck.AccuracyWarning,

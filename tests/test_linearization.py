@@ -106,7 +106,7 @@ def test_linearize_checks_tol():
 def test_batched_central_differences_are_the_column_by_column_ones(n, q, seed):
     # the EKF evaluates g once on the batch of perturbed_states(z); difference_quotients must then give the
     # numbers numerical_jacobian(refine=False) gets from 2n separate calls, and the last column is z
-    from coursekit.linearization import numerical_jacobian, perturbed_states, difference_quotients
+    from coursekit._derivatives import difference_quotients, numerical_jacobian, perturbed_states
     rng = np.random.default_rng(seed)
     z = rng.normal(size=n) * 10 ** rng.uniform(-2, 1.5, size=n)
     a, i, j = rng.normal(size=q), rng.integers(0, n, size=q), rng.integers(0, n, size=q)

@@ -15,6 +15,7 @@ import coursekit as ck
 
 placement = importlib.import_module("coursekit.placement")
 observability = importlib.import_module("coursekit.observability")
+_pole_placement = importlib.import_module("coursekit._pole_placement")
 EPS = np.finfo(float).eps
 
 
@@ -147,12 +148,12 @@ def test_twenty_poles_minus_one_to_minus_twenty_warn_for_feedback_and_observer()
 def test_the_check_catches_a_wrong_gain_and_only_a_wrong_one(monkeypatch, relative_error, warns):
     # a deliberately wrong K (poles moved by about relative_error) must warn; a K wrong only
     # at rounding level must not (the check is neither too lax nor too strict)
-    right = placement.place_gain
+    right = _pole_placement.place_gain
 
     def wrong(A, B, poles):
         K, _ = right(A, B, poles)
         K = K * (1 + relative_error)
-        return K, placement.PoleMatch(A + B @ K, poles)
+        return K, _pole_placement.PoleMatch(A + B @ K, poles)
 
     monkeypatch.setattr(placement, "place_gain", wrong)
     monkeypatch.setattr(observability, "place_gain", wrong)

@@ -291,7 +291,7 @@ def test_scalar_and_array_evaluation_agree():
     traj = ck.poly_trajectory(3.0, np.arange(9.0), -np.arange(9.0))
     t = np.linspace(-0.5, 3.5, 41)
     for k in (0, 4, 12, 17, 18):
-        scalar = [traj._scalar_derivatives(float(tk), k)[k] for tk in t]
+        scalar = [traj.derivatives(float(tk), k)[k] for tk in t]
         # the same Horner sums in the same order: equal to rounding of the last operation
         np.testing.assert_allclose(traj(t, k), scalar, rtol=4 * EPS, atol=0)
 

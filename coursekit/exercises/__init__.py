@@ -22,9 +22,7 @@ declares a check, `ExerciseData` holds its numbers, `Report` collects the feedba
 this session (not tried, not yet, correct) and the section it belongs to.
 """
 
-import importlib as _importlib
-import pkgutil as _pkgutil
-import re as _re
+from .._chapters import chapter_modules as _chapter_modules
 
 # the kit for writing an exercise (docs/extending.md), bound before the chapters import it
 from ._catalog import chapter_exercises, exercise
@@ -38,9 +36,8 @@ __all__ = ["progress", "chapter_exercises", "exercise", "ExerciseData", "CheckRe
            "call_student_function", "rank_decision_feedback"]
 
 # every chapter module chN (a new chapter's too), by N; its names are available here
-for _number, _name in sorted((int(m.group(1)), info.name) for info in _pkgutil.iter_modules(__path__)
-                            if (m := _re.fullmatch(r"ch(\d+)", info.name))):
-    _module = _importlib.import_module(f".{_name}", __name__)
+for _module in _chapter_modules("exercises"):
+    _name = _module.__name__.rsplit(".", 1)[1]
     globals()[_name] = _module
     globals().update({name: getattr(_module, name) for name in _module.__all__})
     __all__ += [_name, *_module.__all__]

@@ -1,9 +1,12 @@
 """The course's tools, beside its algorithms: for instructors and maintainers, not for students.
 
-* `chapters` finds the chapters (notebooks, explorer and exercise modules); `cells` names the
-  roles of a notebook's cells that the other tools read; `builds` holds what the builds share;
+* `chapters` lists the chapters' notebooks, explorers and checks (the modules come from
+  `coursekit._chapters`); `cells` names the roles of a notebook's cells that the other tools
+  read; `builds` holds what the builds share; `kernel_metadata` stores the notebooks' kernel
+  entries;
 * `release` writes the student edition, `slides` the slide metadata, `colab` the install cell;
-* `site` builds the course website (`site_figures` draws its figures for the page), `slideshow`
+* `site` builds the course website (`site_figures` draws its figures for the page,
+  `static_explorers` renders the explorers' frames for pages without a kernel), `slideshow`
   the slides of every chapter, `grading` (a package: grader, runner, kernel, sandbox) grades
   submitted notebooks, each sealed off.
 

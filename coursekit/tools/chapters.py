@@ -9,24 +9,13 @@ fifth chapter is picked up by all of them without an edit.
 
 from __future__ import annotations
 
-import importlib
 import inspect
-import pkgutil
-import re
 from pathlib import Path
 from typing import Callable
 
+from .._chapters import chapter_modules
+
 __all__ = ["chapter_modules", "explorer_factories", "check_functions", "chapter_notebooks"]
-
-
-def chapter_modules(package: str) -> list:
-    """The modules ``chN`` of `package` (``"explorers"`` or ``"exercises"``), by N."""
-    if package not in ("explorers", "exercises"):
-        raise ValueError(f"package must be 'explorers' or 'exercises': received {package!r}.")
-    parent = importlib.import_module(f"coursekit.{package}")
-    found = [(int(m.group(1)), info.name) for info in pkgutil.iter_modules(parent.__path__)
-             if (m := re.fullmatch(r"ch(\d+)", info.name))]
-    return [importlib.import_module(f"{parent.__name__}.{name}") for _, name in sorted(found)]
 
 
 def _public_functions(package: str, test: Callable[[str], bool]) -> dict[str, Callable]:

@@ -55,6 +55,7 @@ __all__ = [
     "run_online",
     "describe_images",
     "figure_text_sizes",
+    "WIDGET_VIEW", "ALT", "SMALLEST_TEXT",
 ]
 
 WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"

@@ -184,8 +184,8 @@ def _webp(rgba) -> bytes:
 
 
 def _smallest_text_pt(fig) -> float | None:
-    from .site_figures import _shown_texts
-    return min((t.get_fontsize() for t in _shown_texts(fig)), default=None)
+    from .site_figures import smallest_text_pt
+    return smallest_text_pt(fig)
 
 
 def _move(explorer, settings: dict, defaults: dict, view) -> None:

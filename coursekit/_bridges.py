@@ -38,10 +38,8 @@ import re
 
 import numpy as np
 
+# used through StateSpace's methods (and `as_system`); none is a top-level name of coursekit
 __all__ = ["realization_hint", "from_control", "to_control", "from_scipy", "to_scipy"]
-
-# The bridges are used through StateSpace's methods; nothing here is a top-level name.
-__all__: list[str] = []
 
 _GENERIC_CONTROL_NAME = re.compile(r"sys\[\d+\]")
 
