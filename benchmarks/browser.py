@@ -215,8 +215,10 @@ def _table(explorers: list[str], kernel_ms: dict, results: dict) -> list[str]:
         run = results[label][0]
         ms = kernel_ms[label]
         light = " (light)" if ms <= LIGHT_MS else ""
+        ratio = statistics.median(run['steps']) / floor
+        first = f"{run['first']:.1f}" + (" (missed)" if run['first'] < (20 if light else 10) else "")
         rows.append(f"| {label}{light} | {ms:.0f} ms | {statistics.median(run['steps']):.0f} ms "
-                    f"| {max(run['steps']):.0f} ms | {statistics.median(run['steps']) / floor:.2f} "
-                    f"| {run['first']:.1f} | {run['updates']:.1f} | {run['values']:.0f} | {run['lag']:.0f} ms "
+                    f"| {max(run['steps']):.0f} ms | {ratio:.2f}{' (missed)' if ratio > 1.3 else ''} "
+                    f"| {first} | {run['updates']:.1f} | {run['values']:.0f} | {run['lag']:.0f} ms "
                     f"| {run['cpu_chromium']:.2f}, {run['cpu_kernel']:.2f} |")
     return rows
