@@ -18,7 +18,7 @@ line into the standard set of bad values for a matrix, a scalar, a list of
 poles or a user function.
 
 `main()` is the worker, started by tests/test_bad_input.py in a process of its
-own once the whole module (cases added at its end included) is imported: it reads case ids (one per line)
+own once the whole module (the chapters' own files of cases included) is imported: it reads case ids (one per line)
 on stdin, runs each under a per-case deadline and prints one JSON line per
 case (and a "start" line before it, so that the parent can tell which case a
 killed worker was running).
@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import contextlib
 import faulthandler
+import importlib
 import inspect
 import io
 import json
@@ -38,6 +39,7 @@ import time
 import traceback
 import warnings
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Callable
 
 import numpy as np
@@ -1011,6 +1013,11 @@ for _check, _count in _EXERCISE_ARGS.items():
 # issue 35: a rank typed as text stays refused, with a message about the rank (not a matrix example)
 feedback("exercises.check_kalman_decision", "rank the string '2'", lambda: ex.check_kalman_decision("2", False),
          r"rank must be a whole number, not text: received the string '2'; type the number without quotes")
+
+# a chapter's own cases live in its own file, tests/bad_input_chN.py (docs/extending.md), which
+# takes bad, ok, scalar_cases, ... from this module
+for _path in sorted(Path(__file__).parent.glob("bad_input_ch*.py")):
+    importlib.import_module(_path.stem)
 
 # ---------------------------------------------------------------------------
 # the worker

@@ -40,11 +40,20 @@ def _run(args: list[str], cwd: Path, timeout: int) -> subprocess.CompletedProces
 
 def test_the_doc_has_an_explorer_an_exercise_and_a_chapter():
     files = [body.splitlines()[0] for lang, body in _blocks() if body.startswith("# file: ")]
-    assert files == ["# file: coursekit/explorers/ch5.py", "# file: coursekit/exercises/ch5.py"]
+    assert files == ["# file: coursekit/explorers/ch5.py", "# file: coursekit/exercises/ch5.py",
+                     "# file: tests/bad_input_ch5.py"]
     text = DOC.read_text(encoding="utf-8")
     for public in ("from coursekit.explorers import Explorer", "from coursekit.exercises import"):
         assert public in text
     assert not re.search(r"coursekit\.\w+\._|from \._|import _", text), "the doc uses a private name"
+
+
+#: the files of chapter 5, the only ones the doc may add or change (besides what builds write)
+CHAPTER_5 = {"coursekit/explorers/ch5.py", "coursekit/exercises/ch5.py", "tests/bad_input_ch5.py",
+             "notebooks/05_lag.ipynb"}
+#: what running the checks and builds leaves in the copy
+BUILT = {".git", "__pycache__", ".pytest_cache", ".hypothesis", "build", "site", "site-student",
+         ".ipynb_checkpoints", ".venv"}
 
 
 @pytest.fixture(scope="module")
@@ -66,6 +75,16 @@ def extended(tmp_path_factory) -> Path:
     assert result.returncode == 0, f"the doc's blocks failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
     (copy / "extending_blocks.py").unlink()
     return copy
+
+
+def test_the_new_chapter_needs_no_edit_outside_its_own_files(extended):
+    def files(root: Path) -> dict:
+        return {str(p.relative_to(root)): p for p in root.rglob("*") if p.is_file()
+                and not BUILT & set(p.relative_to(root).parts) and not p.parent.name.endswith(".egg-info")}
+    before, after = files(ROOT), files(extended)
+    touched = {name for name, path in after.items()
+               if name not in before or path.read_bytes() != before[name].read_bytes()}
+    assert touched == CHAPTER_5, f"outside chapter 5's files: {sorted(touched - CHAPTER_5)}"
 
 
 def test_the_new_chapter_is_found_by_the_course_tools(extended):
