@@ -65,7 +65,7 @@ from ._validation import as_matrix, as_square, require_columns, warn_accuracy
 from .diagnostics import NotControllableError
 
 __all__ = ["as_pair", "as_obs_pair", "ctrb_unchecked", "numerical_rank", "Staircase", "unit_free_staircase",
-           "check_tol", "marginal_note", "require_controllable", "canonical_transform"]
+           "check_tol", "marginal_note", "balancing", "require_controllable", "canonical_transform"]
 
 
 _EPS = np.finfo(float).eps
@@ -154,7 +154,7 @@ def _scale_states(A: np.ndarray, B: np.ndarray, s: np.ndarray):
     return A / s[:, None] * s[None, :], B / s[:, None]
 
 
-def _balancing(A: np.ndarray, B: np.ndarray) -> np.ndarray:
+def balancing(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     """State scaling (powers of two) that balances [[A, B], [0, 0]] (LAPACK gebal, job 'S')."""
     from scipy.linalg import get_lapack_funcs
 
@@ -211,7 +211,7 @@ def _unit_free(A: np.ndarray, B: np.ndarray):
     """
     A, B, alpha, beta = _normalize(A, B)
     d = np.ones(A.shape[0])
-    for scaling in (_balancing, _sink_scaling, _balancing, _krylov_scaling):
+    for scaling in (balancing, _sink_scaling, balancing, _krylov_scaling):
         s = scaling(A, B)
         A, B = _scale_states(A, B, s)
         A, B, a, b = _normalize(A, B)

@@ -11,7 +11,7 @@ import warnings
 
 import numpy as np
 
-from ._pairs import numerical_rank
+from ._pairs import balancing, numerical_rank
 from ._validation import warn_accuracy
 from .diagnostics import NotControllableError
 
@@ -117,7 +117,7 @@ def _heymann(A: np.ndarray, B_r: np.ndarray, poles: np.ndarray, tries: int = 6):
     """
     rng = np.random.default_rng(0)                    # seeded: the same K on every call
     n, r = B_r.shape
-    d = _balancing(A, B_r)
+    d = balancing(A, B_r)
     A_b, B_b = A / d[:, None] * d, B_r / d[:, None]   # balanced pair D^-1 A D, D^-1 B
     size = np.linalg.norm(A_b, 1) / np.linalg.norm(B_b, 1)
     best = None
@@ -144,16 +144,6 @@ def _heymann(A: np.ndarray, B_r: np.ndarray, poles: np.ndarray, tries: int = 6):
     return best
 
 
-def _balancing(A: np.ndarray, B: np.ndarray) -> np.ndarray:
-    """Diagonal state scaling d (powers of 2) balancing [[A, B], [0, 0]] (LAPACK gebal)."""
-    n = A.shape[0]
-    M = np.zeros((n + B.shape[1], n + B.shape[1]))
-    M[:n, :n], M[:n, n:] = A, B
-    from scipy.linalg import matrix_balance  # imported here: `import coursekit` stays light
-    _, (scale, _) = matrix_balance(M, permute=False, separate=True)
-    return scale[:n]
-
-
 def _single_input(A: np.ndarray, b: np.ndarray, poles: np.ndarray) -> np.ndarray:
     """The unique k, shape (1, n), with eig(A + b k) = poles (3.46)-(3.47), accurately.
 
@@ -166,7 +156,7 @@ def _single_input(A: np.ndarray, b: np.ndarray, poles: np.ndarray) -> np.ndarray
     a conjugate pair, at a time, rescaling as it goes so nothing overflows.
     """
     n = A.shape[0]
-    d = _balancing(A, b.reshape(n, 1))
+    d = balancing(A, b.reshape(n, 1))
     A_b, b_b = A / d[:, None] * d, b / d
     Q1, beta = _householder(b_b)                              # Q1^T b = beta e_1
     from scipy.linalg import hessenberg

@@ -15,8 +15,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._arguments import as_system
 from ._pairs import as_pair, canonical_transform, check_tol, ctrb_unchecked, unit_free_staircase
-from ._system_arg import as_system
 from ._validation import as_square, warn_accuracy
 from .systems import StateSpace
 

@@ -22,7 +22,7 @@ from typing import Callable
 
 import numpy as np
 
-from ._system_arg import as_system
+from ._arguments import as_system
 from ._validation import as_matrix, as_scalar, as_square, as_vector, checked_call, float_array, require_columns
 from .diagnostics import UserFunctionError
 from .systems import NonlinearSystem, StateSpace

@@ -13,9 +13,9 @@ from typing import Callable
 
 import numpy as np
 
+from ._arguments import as_system
 from ._derivatives import difference_quotients, numerical_jacobian, perturbed_states
 from ._filter_ode import checked_substeps, filter_setup, initial_estimate, records, run_filter
-from ._system_arg import as_system
 from ._validation import agrees_column_by_column, call_user_fast
 from .diagnostics import UserFunctionError
 from .kalman_bucy import KalmanResult

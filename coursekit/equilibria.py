@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._system_arg import as_system
+from ._arguments import as_system
 from ._validation import (as_dt, as_integer, as_matrix, as_scalar, as_vector, call_user, foreign_library,
                           function_name, input_size_explained, sympy_column)
 from .diagnostics import UserFunctionError

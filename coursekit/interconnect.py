@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._system_arg import as_system
+from ._arguments import as_system
 from ._validation import as_scalar
 from .systems import StateSpace
 

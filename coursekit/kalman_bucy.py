@@ -21,8 +21,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._arguments import as_system
 from ._filter_ode import advance, all_finite, checked_substeps, diverged, filter_setup, next_step, records
-from ._system_arg import as_system
 
 __all__ = ["kalman_bucy", "KalmanResult"]
 

@@ -27,8 +27,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._arguments import as_system
 from ._filter_ode import initial_estimate
-from ._system_arg import as_system
 from ._validation import as_covariance, as_series
 from .kalman_bucy import KalmanResult
 from .systems import StateSpace

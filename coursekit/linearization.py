@@ -20,8 +20,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._arguments import as_system
 from ._derivatives import checked_jacobian
-from ._system_arg import as_system
 from ._validation import (as_dt, as_flag, as_scalar, as_vector, call_user, foreign_library, function_name,
                           input_size_explained, is_complex, is_text, sympy_column)
 from .systems import NonlinearSystem, StateSpace

@@ -15,9 +15,9 @@ from __future__ import annotations
 
 import numpy as np
 
+from ._arguments import as_system
 from ._filter_ode import records
 from ._stepping import check_finite, step_matrices
-from ._system_arg import as_system
 from ._validation import as_covariance, as_scalar, as_square, as_time_grid, as_vector, is_uniform
 from .simulation import SimulationResult
 from .systems import StateSpace

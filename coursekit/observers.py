@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._system_arg import as_system
+from ._arguments import as_system
 from ._validation import as_matrix, as_series
 from .systems import StateSpace
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._figure_arg import figure_for
+from ._arguments import figure_for
 from ._validation import as_integer, as_matrix, as_text
 from .style import curve_style, new_figure, text_colour
 

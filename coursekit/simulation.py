@@ -33,8 +33,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._arguments import as_system
 from ._stepping import check_finite, overflow_error, step_matrices
-from ._system_arg import as_system
 from ._validation import (agrees_column_by_column, as_matrix, as_scalar, as_series, as_square, as_time_grid,
                           as_vector, call_user, checked_call, is_uniform, require_columns)
 from .diagnostics import SimulationError, UserFunctionError

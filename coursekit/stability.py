@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ._system_arg import as_system
+from ._arguments import as_system
 from ._validation import as_dt, as_square, foreign_library
 from .systems import StateSpace
 
@@ -95,7 +95,7 @@ def plot_poles(poles, *, dt=None, ax=None, title: str | None = None):
     """
     sets = _as_pole_sets(poles)
     dt = as_dt(dt)
-    from ._figure_arg import figure_for
+    from ._arguments import figure_for
     from .style import PALETTE, curve_style
     fig, ax = figure_for(ax)
     green = PALETTE["bluish green"]

@@ -7,7 +7,7 @@ of (1.33). Both expose `f(x, u)` and `h(x, u)` so that `simulate` treats
 them alike.
 
 `raw_field()` and `raw_output()` give the model's own f and h, without the checks, for
-hot loops. A function that takes a system checks it with `_system_arg.as_system`.
+hot loops. A function that takes a system checks it with `_arguments.as_system`.
 """
 
 from __future__ import annotations

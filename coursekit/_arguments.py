@@ -1,5 +1,5 @@
-"""The system argument of a public function: a coursekit system, or one converted from
-python-control or scipy.signal through the bridges (`StateSpace.from_control`, `from_scipy`)."""
+"""The system and axes arguments of public functions: `as_system` takes a coursekit system, or one
+of python-control or scipy.signal through the bridges; `figure_for` the Axes to draw into."""
 
 from __future__ import annotations
 
@@ -8,9 +8,10 @@ import sys as _sys
 import numpy as np
 
 from ._validation import BRIDGES, foreign_library, type_name
+from .style import new_figure
 from .systems import NonlinearSystem, StateSpace
 
-__all__ = ["as_system"]
+__all__ = ["as_system", "figure_for"]
 
 
 _KINDS = {"any": "StateSpace or NonlinearSystem", "linear": "StateSpace", "nonlinear": "NonlinearSystem"}
@@ -70,3 +71,18 @@ def _from_foreign(value, name: str, library: str):
             "or the sampling period."
         )
     return getattr(StateSpace, bridge.split(".")[1])(value)
+
+
+def figure_for(ax, *, figsize=None):
+    """(fig, ax): a new figure when `ax` is None, else the figure of the Axes `ax` (checked).
+
+    Anything but a matplotlib Axes raises ValueError naming `ax`, instead of an
+    AttributeError deep inside the drawing.
+    """
+    if ax is None:
+        return new_figure(1, 1, figsize=figsize)
+    from matplotlib.axes import Axes
+    if not isinstance(ax, Axes):
+        raise ValueError(f"ax must be a matplotlib Axes: received {type(ax).__name__}; "
+                         "leave it out to draw a new figure, or pass one axes of new_figure().")
+    return ax.figure, ax
