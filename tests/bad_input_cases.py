@@ -49,7 +49,6 @@ import coursekit.exercises as ex
 from coursekit.exercises._feedback import CheckResult
 from coursekit import models
 from coursekit.tools.chapters import check_functions
-from coursekit.explorers import ch1 as xp1, ch2 as xp2, ch3 as xp3, ch4 as xp4
 
 #: seconds a single case may take before it counts as a hang (the slowest good case
 #: takes about 0.6 s once the libraries are imported, on a machine loaded 3x over its cores)
@@ -159,6 +158,13 @@ def scalar_cases(target: str, arg: str, build: Callable, good=1.0, *, positive=F
         values.update({"zero": 0.0, "negative": -abs(good)})
     for label, value in values.items():
         bad(target, f"{arg} {label}", lambda value=value: build(value), arg)
+
+
+def span_cases(target: str, call: Callable) -> None:
+    """A time span t_end of 1e300 and 10**12 or 1e300 samples: refused at once, naming the argument."""
+    bad(target, "t_end 1e300", lambda: call(t_end=1e300), "t_end")
+    bad(target, "samples 10**12", lambda: call(samples=10**12), "samples")
+    bad(target, "samples 1e300", lambda: call(samples=1e300), "samples")
 
 
 def poles_cases(target: str, arg: str, build: Callable, good, *, any_count: bool = False) -> None:
@@ -755,57 +761,6 @@ bad("models.two_wheeled_robot", "f with wrong x", lambda: models.two_wheeled_rob
 bad("models.pendulum", "f with wrong u", lambda: models.pendulum().f(np.zeros(2), np.zeros(3)), "u")
 
 # ---------------------------------------------------------------------------
-# explorers: the pure compute functions
-
-scalar_cases("explorers.euler_compute", "Ts", lambda Ts: xp1.euler_compute(Ts), 0.1, positive=True)
-bad("explorers.euler_compute", "example unknown", lambda: xp1.euler_compute(0.1, example="cubic"), "example")
-bad("explorers.euler_compute", "samples 1", lambda: xp1.euler_compute(0.1, samples=1), "samples")
-bad("explorers.euler_compute", "samples 10**12", lambda: xp1.euler_compute(0.1, samples=10**12), "samples")
-bad("explorers.euler_compute", "Ts 1e-300", lambda: xp1.euler_compute(1e-300), "Ts")
-bad("explorers.msd_compute", "m tiny, k huge", lambda: xp1.msd_compute(1e-300, 0.5, 1e300), "m")
-bad("explorers.kalman_tuning_compute", "log10_q 400", lambda: xp4.kalman_tuning_compute(400.0, 0.0), "log10_q")
-bad("explorers.pole_placement_compute", "wn 1e300", lambda: xp3.pole_placement_compute(wn=1e300), "wn")
-bad("explorers.euler_compute", "samples fractional", lambda: xp1.euler_compute(0.1, samples=10.5), "samples")
-scalar_cases("explorers.msd_compute", "m", lambda m: xp1.msd_compute(m, 0.5, 2.0), 1.0, positive=True)
-bad("explorers.msd_compute", "d NaN", lambda: xp1.msd_compute(1.0, np.nan, 2.0), "d")
-bad("explorers.msd_compute", "t_end negative", lambda: xp1.msd_compute(1.0, 0.5, 2.0, t_end=-1.0), "t_end")
-bad("explorers.msd_compute", "t_end NaN", lambda: xp1.msd_compute(1.0, 0.5, 2.0, t_end=np.nan), "t_end")
-bad("explorers.msd_compute", "samples 0", lambda: xp1.msd_compute(1.0, 0.5, 2.0, samples=0), "samples")
-bad("explorers.msd_compute", "experiment unknown", lambda: xp1.msd_compute(1.0, 0.5, 2.0, experiment="ramp"), "experiment")
-scalar_cases("explorers.planner_compute", "T", lambda T: xp2.planner_compute(T=T), 3.0, positive=True)
-bad("explorers.planner_compute", "r 1", lambda: xp2.planner_compute(r=1), "r")
-bad("explorers.planner_compute", "mass_error -100", lambda: xp2.planner_compute(mass_error=-100.0), "mass_error")
-bad("explorers.planner_compute", "samples 1", lambda: xp2.planner_compute(samples=1), "samples")
-scalar_cases("explorers.robot_planner_compute", "x_T", lambda x: xp2.robot_planner_compute(x_T=x), 4.0)
-bad("explorers.robot_planner_compute", "T zero", lambda: xp2.robot_planner_compute(T=0.0), "T")
-bad("explorers.robot_planner_compute", "samples 1", lambda: xp2.robot_planner_compute(samples=1), "samples")
-ok("explorers.drive_robot", "good", lambda: xp2.drive_robot(T11, np.ones((11, 2)), np.zeros(3)))
-bad("explorers.drive_robot", "u wrong shape", lambda: xp2.drive_robot(T11, np.ones((11, 3)), np.zeros(3)), "u")
-bad("explorers.drive_robot", "x0 complex", lambda: xp2.drive_robot(T11, np.ones((11, 2)), np.zeros(3) + 1j), "x0")
-bad("explorers.drive_robot", "t NaN", lambda: xp2.drive_robot(T11 * np.nan, np.ones((11, 2)), np.zeros(3)), "t")
-scalar_cases("explorers.pair_poles", "zeta", lambda z: xp3.pair_poles(2.0, z), 0.7, positive=True)
-scalar_cases("explorers.pole_placement_compute", "wn", lambda w: xp3.pole_placement_compute(wn=w), 2.0, positive=True)
-bad("explorers.pole_placement_compute", "p3 NaN", lambda: xp3.pole_placement_compute(p3=np.nan), "p3")
-bad("explorers.pole_placement_compute", "p3 complex", lambda: xp3.pole_placement_compute(p3=-3 + 1j), "p3")
-bad("explorers.pole_placement_compute", "t_end zero", lambda: xp3.pole_placement_compute(t_end=0.0), "t_end")
-bad("explorers.pole_placement_compute", "samples 1", lambda: xp3.pole_placement_compute(samples=1), "samples")
-scalar_cases("explorers.upright_pendulum_compute", "theta0_deg", lambda th: xp3.upright_pendulum_compute(theta0_deg=th), 30.0)
-bad("explorers.upright_pendulum_compute", "pole positive", lambda: xp3.upright_pendulum_compute(pole=1.0), "pole")
-bad("explorers.upright_pendulum_compute", "u_max negative", lambda: xp3.upright_pendulum_compute(u_max=-1.0), "u_max")
-bad("explorers.upright_pendulum_compute", "pole NaN", lambda: xp3.upright_pendulum_compute(pole=np.nan), "pole")
-scalar_cases("explorers.integral_action_compute", "d", lambda d: xp3.integral_action_compute(d=d), 1.0)
-bad("explorers.integral_action_compute", "integral_pole positive", lambda: xp3.integral_action_compute(integral_pole=1.0), "integral_pole")
-bad("explorers.integral_action_compute", "t_end inf", lambda: xp3.integral_action_compute(t_end=np.inf), "t_end")
-scalar_cases("explorers.observer_noise_compute", "noise_std", lambda s: xp4.observer_noise_compute(1.0, s), 0.1)
-bad("explorers.observer_noise_compute", "noise_std negative", lambda: xp4.observer_noise_compute(1.0, -0.1), "noise_std")
-bad("explorers.observer_noise_compute", "speed NaN", lambda: xp4.observer_noise_compute(np.nan, 0.1), "speed")
-bad("explorers.observer_noise_compute", "samples 1", lambda: xp4.observer_noise_compute(1.0, 0.1, samples=1), "samples")
-scalar_cases("explorers.kalman_tuning_compute", "log10_q", lambda q: xp4.kalman_tuning_compute(q, 0.0), 0.0)
-bad("explorers.kalman_tuning_compute", "log10_r inf", lambda: xp4.kalman_tuning_compute(0.0, np.inf), "log10_r")
-bad("explorers.kalman_tuning_compute", "t_end zero", lambda: xp4.kalman_tuning_compute(0.0, 0.0, t_end=0.0), "t_end")
-bad("explorers.kalman_tuning_compute", "seed text", lambda: xp4.kalman_tuning_compute(0.0, 0.0, seed="a"), "seed")
-
-# ---------------------------------------------------------------------------
 # issue 25: the tail of bad inputs (hangs, raw internal errors, silent acceptances) and the
 # systems of python-control and scipy.signal
 
@@ -855,19 +810,6 @@ bad("kalman_bucy", "substeps 10**9", lambda: _kb(substeps=10**9), "substeps", al
 bad("extended_kalman_filter", "substeps 10**9", lambda: _ekf(substeps=10**9), "substeps", also="at most 1000")
 bad("kalman_gain", "Q zero, undriven double integrator",
     lambda: ck.kalman_gain([[0.0, 1.0], [0.0, 0.0]], C2, np.zeros((2, 2)), R1), "Q", also=r"does not drive it")
-for _label, _call in (("msd_compute", lambda **kw: xp1.msd_compute(1.0, 0.5, 2.0, **kw)),
-                      ("pole_placement_compute", xp3.pole_placement_compute),
-                      ("upright_pendulum_compute", xp3.upright_pendulum_compute),
-                      ("integral_action_compute", xp3.integral_action_compute),
-                      ("observer_noise_compute", lambda **kw: xp4.observer_noise_compute(1.0, 0.1, **kw)),
-                      ("kalman_tuning_compute", lambda **kw: xp4.kalman_tuning_compute(0.0, 0.0, **kw))):
-    bad(f"explorers.{_label}", "t_end 1e300", lambda _call=_call: _call(t_end=1e300), "t_end")
-    bad(f"explorers.{_label}", "samples 10**12", lambda _call=_call: _call(samples=10**12), "samples")
-    bad(f"explorers.{_label}", "samples 1e300", lambda _call=_call: _call(samples=1e300), "samples")
-for _label, _call in (("planner_compute", xp2.planner_compute), ("robot_planner_compute", xp2.robot_planner_compute)):
-    bad(f"explorers.{_label}", "T 1e300", lambda _call=_call: _call(T=1e300), "T")
-    bad(f"explorers.{_label}", "samples 10**12", lambda _call=_call: _call(samples=10**12), "samples")
-bad("explorers.observer_noise_compute", "seed 10**400", lambda: xp4.observer_noise_compute(1.0, 0.1, seed=10**400), "seed")
 bad("OpenLoopPlan", "plot samples 10**12", lambda: _olc().plot(samples=10**12), "samples")
 bad("FlatPlan", "plot samples 10**12", lambda: _pflat().plot(samples=10**12), "samples")
 for _name, _fn in (("symbolic_ctrb", ck.symbolic_ctrb), ("symbolic_linear_flatness", ck.symbolic_linear_flatness)):
@@ -948,12 +890,6 @@ for _label, _m in (("zero", 0.0), ("negative", -1.0)):
     bad("symbolic_flat_maps", f"m {_label}", lambda _m=_m: ck.symbolic_flat_maps("pendulum", m=_m), "m")
 bad("FlatSystem", "psi_x derivs complex", lambda: ck.pendulum_flatness().psi_x([0.1 + 1j, 0.0]), "derivs")
 bad("FlatSystem", "psi_u derivs numpy complex", lambda: ck.pendulum_flatness().psi_u(np.array([0.1 + 1j, 0.0, 0.0])), "derivs")
-bad("explorers.planner_compute", "r 10**9", lambda: xp2.planner_compute(r=10**9), "r")
-ok("explorers.pair_poles", "zeta 1e300 (zeta**2 overflowed)", lambda: xp3.pair_poles(2.0, 1e300))
-bad("explorers.pole_placement_compute", "zeta 1e300", lambda: xp3.pole_placement_compute(zeta=1e300), "zeta")
-bad("explorers.observer_noise_compute", "noise_std 1e300", lambda: xp4.observer_noise_compute(1.0, 1e300), "noise_std")
-for _arg in ("x_T", "y_T", "speed"):
-    bad("explorers.robot_planner_compute", f"{_arg} 1e300", lambda _arg=_arg: xp2.robot_planner_compute(**{_arg: 1e300}), _arg)
 for _name, _call in (("charpoly", lambda: ck.charpoly(A2 * 1e200)),
                      ("linear_flatness", lambda: ck.linear_flatness(A2 * 1e200, B2 * 1e200)),
                      ("place_details", lambda: ck.place_details(A2 * 1e200, B2 * 1e200, P2)),
@@ -1014,8 +950,9 @@ for _check, _count in _EXERCISE_ARGS.items():
 feedback("exercises.check_kalman_decision", "rank the string '2'", lambda: ex.check_kalman_decision("2", False),
          r"rank must be a whole number, not text: received the string '2'; type the number without quotes")
 
-# a chapter's own cases live in its own file, tests/bad_input_chN.py (docs/extending.md), which
-# takes bad, ok, scalar_cases, ... from this module
+# ---------------------------------------------------------------------------
+# each chapter's explorer functions: its own file tests/bad_input_chN.py (docs/extending.md),
+# which takes bad, ok, scalar_cases, ... from this module
 for _path in sorted(Path(__file__).parent.glob("bad_input_ch*.py")):
     importlib.import_module(_path.stem)
 
