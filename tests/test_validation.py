@@ -1,6 +1,5 @@
 """The shared input checks of coursekit._validation on the inputs that used to escape them."""
 
-
 import pytest
 
 from coursekit import _validation as v
