@@ -2,44 +2,27 @@
 explorer, an exercise and a fifth chapter, and the checks every chapter must pass pick the new
 chapter up there.
 
-A ``python`` block whose first line is ``# file: PATH`` is written to PATH; every other
-``python`` block runs, in order, in one interpreter started at the copy's root.
+The copy is made by `extending_doc.extend`; CI's extended run runs the README's whole test command
+in such a copy (``.ci/run``), where this module skips itself.
 """
 
 from __future__ import annotations
 
-import os
 import re
 import shutil
-import subprocess
 import sys
 from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-DOC = ROOT / "docs" / "extending.md"
-BLOCK = re.compile(r"^```(\w+)\n(.*?)^```", re.MULTILINE | re.DOTALL)
+from extending_doc import BUILT, DOC, ROOT, doc_blocks, extend, is_extended, run_in
 
-
-def _blocks() -> list[tuple[str, str]]:
-    return [(lang, body) for lang, body in BLOCK.findall(DOC.read_text(encoding="utf-8"))]
-
-
-def _copy_project(to: Path) -> None:
-    """The project's files as a fresh clone has them (no caches, builds or git data)."""
-    ignore = shutil.ignore_patterns(".git", "__pycache__", "*.egg-info", ".hypothesis", "build", "site",
-                                    "site-student", ".ipynb_checkpoints", ".venv")
-    shutil.copytree(ROOT, to, ignore=ignore)
-
-
-def _run(args: list[str], cwd: Path, timeout: int) -> subprocess.CompletedProcess:
-    env = dict(os.environ, PYTHONPATH=str(cwd), MPLBACKEND="Agg")
-    return subprocess.run(args, cwd=cwd, env=env, capture_output=True, text=True, timeout=timeout)
+pytestmark = pytest.mark.skipif(is_extended(), reason="this project already holds the doc's chapter 5 "
+                                "(the copy CI's extended run tests); the doc is checked on the original")
 
 
 def test_the_doc_has_an_explorer_an_exercise_and_a_chapter():
-    files = [body.splitlines()[0] for lang, body in _blocks() if body.startswith("# file: ")]
+    files = [body.splitlines()[0] for lang, body in doc_blocks() if body.startswith("# file: ")]
     assert files == ["# file: coursekit/explorers/ch5.py", "# file: coursekit/exercises/ch5.py",
                      "# file: tests/bad_input_ch5.py"]
     text = DOC.read_text(encoding="utf-8")
@@ -51,29 +34,13 @@ def test_the_doc_has_an_explorer_an_exercise_and_a_chapter():
 #: the files of chapter 5, the only ones the doc may add or change (besides what builds write)
 CHAPTER_5 = {"coursekit/explorers/ch5.py", "coursekit/exercises/ch5.py", "tests/bad_input_ch5.py",
              "notebooks/05_lag.ipynb"}
-#: what running the checks and builds leaves in the copy
-BUILT = {".git", "__pycache__", ".pytest_cache", ".hypothesis", "build", "site", "site-student",
-         ".ipynb_checkpoints", ".venv"}
 
 
 @pytest.fixture(scope="module")
 def extended(tmp_path_factory) -> Path:
     """A copy of the project with every block of the doc applied."""
     copy = tmp_path_factory.mktemp("extended") / "project"
-    _copy_project(copy)
-    script = []
-    for lang, body in _blocks():
-        if lang != "python":
-            continue
-        if body.startswith("# file: "):
-            path = copy / body.splitlines()[0].removeprefix("# file: ").strip()
-            path.write_text(body.split("\n", 1)[1], encoding="utf-8")
-        else:
-            script.append(body)
-    (copy / "extending_blocks.py").write_text("\n\n".join(script), encoding="utf-8")
-    result = _run([sys.executable, "extending_blocks.py"], copy, timeout=600)
-    assert result.returncode == 0, f"the doc's blocks failed:\n{result.stdout[-3000:]}\n{result.stderr[-3000:]}"
-    (copy / "extending_blocks.py").unlink()
+    extend(copy)
     return copy
 
 
@@ -92,11 +59,11 @@ def test_the_new_chapter_is_found_by_the_course_tools(extended):
             "import coursekit.exercises as ex\n"
             "print(sorted(explorer_factories())[-1], sorted(check_functions())[-1], "
             "chapter_notebooks('notebooks')[-1].name, [e.check for e in ex.chapter_exercises(5)])")
-    result = _run([sys.executable, "-c", code], extended, timeout=120)
+    result = run_in([sys.executable, "-c", code], extended, timeout=120)
     assert result.returncode == 0, result.stderr[-3000:]
     assert result.stdout.split() == ["ch5.lag_explorer", "ch5.check_lag_gain", "05_lag.ipynb",
                                      "['check_lag_gain']"]
-    release = _run([sys.executable, "-m", "coursekit", "release", "--out", "build/student"], extended, timeout=120)
+    release = run_in([sys.executable, "-m", "coursekit", "release", "--out", "build/student"], extended, timeout=120)
     assert release.returncode == 0, release.stderr[-3000:]
     assert (extended / "build" / "student" / "05_lag.ipynb").is_file()
 
@@ -108,7 +75,7 @@ def test_the_new_chapter_is_found_by_the_course_tools(extended):
     ["tests/test_figure_style.py", "-k", "lag_explorer or 05_lag"],
 ], ids=["notebook and slides", "bad input", "explorer frames and layout", "colours and contrast"])
 def test_the_checks_every_chapter_must_pass_pass_for_the_new_chapter(extended, args):
-    result = _run([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *args], extended, timeout=900)
+    result = run_in([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *args], extended, timeout=900)
     assert result.returncode == 0, result.stdout[-5000:]
     assert re.search(r"\b\d+ passed", result.stdout), result.stdout[-2000:]
 
@@ -127,6 +94,6 @@ def test_the_release_command_of_the_doc_runs_after_the_instructors_guide_s(exten
     assert first, "docs/instructors.md no longer writes build/student"
     again = re.search(r"`python -m coursekit (release --out build/student[^`]*)`", DOC.read_text(encoding="utf-8"))
     for command in (first.group(0).split()[3:], again.group(1).split()):
-        result = _run([sys.executable, "-m", "coursekit", *command], extended, timeout=300)
+        result = run_in([sys.executable, "-m", "coursekit", *command], extended, timeout=300)
         assert result.returncode == 0, result.stderr[-2000:]
     assert len(list((extended / "build" / "student").glob("0*.ipynb"))) == 5
