@@ -1,7 +1,9 @@
 """The course's tools, beside its algorithms: for instructors and maintainers, not for students.
 
-* `chapters` finds the chapters (notebooks, explorer and exercise modules); `cells` names the
-  roles of a notebook's cells that the other tools read; `builds` holds what the builds share;
+* `notebooks` finds, reads, writes and executes the chapter notebooks and gives their figures
+  their text alternatives, for every tool below; `chapters` finds the chapters' explorer and
+  exercise modules; `cells` names the roles of a notebook's cells that the other tools read;
+  `builds` holds what the builds share;
 * `release` writes the student edition, `slides` the slide metadata, `colab` the install cell;
 * `site` builds the course website (`site_figures` draws its figures for the page), `slideshow`
   the slides of every chapter, `grading` (a package: grader, runner, kernel, sandbox) grades
