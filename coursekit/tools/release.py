@@ -81,18 +81,14 @@ def _add_note(nb) -> None:
         nb.cells.insert(0, new_markdown_cell(STUDENT_NOTE))
 
 
-def _check_notebook(nb) -> None:
-    if not hasattr(nb, "cells") or not hasattr(nb, "metadata"):
-        raise TypeError(f"nb must be a notebook (nbformat NotebookNode): received {type(nb).__name__}; "
-                        "read it with coursekit.tools.notebooks.read_notebook(path).")
-
-
 def student_text(nb):
     """A copy of `nb` with the student edition's cells and text, its outputs kept: the cells
     tagged ``solution`` removed (nbconvert's ``TagRemovePreprocessor``), the exercise section's
     pointers to them dropped and the note added to the first cell; `nb` is unchanged."""
     from nbconvert.preprocessors import TagRemovePreprocessor
-    _check_notebook(nb)
+    if not hasattr(nb, "cells") or not hasattr(nb, "metadata"):
+        raise TypeError(f"nb must be a notebook (nbformat NotebookNode): received {type(nb).__name__}; "
+                        "read it with coursekit.tools.notebooks.read_notebook(path).")
     nb, _ = TagRemovePreprocessor(remove_cell_tags={SOLUTION_TAG}).preprocess(copy.deepcopy(nb), {})
     for cell in nb.cells:
         if cell.cell_type == "markdown" and role(cell) == EXERCISE:
