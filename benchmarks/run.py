@@ -8,6 +8,7 @@ Run from the repository root (with the `dev` extra installed):
     python benchmarks/run.py --browser-only   # only the browser benchmark (benchmarks/browser.py)
     python benchmarks/run.py --grading        # everything, plus the grader (python -m coursekit grade)
     python benchmarks/run.py --grading-only   # only the grader benchmark
+    python benchmarks/run.py --builds-only    # only the builds (site, student site, slides)
 
 Each pair of competitors is timed in interleaved repetitions (a, b, a, b, ...)
 so that drift in the machine's speed affects both alike; the table reports
@@ -296,6 +297,9 @@ ABOUT = {
                "minute with two at a time against one at a time, grading one notebook in the bubblewrap "
                "sandbox against the same without it (`--no-sandbox`), and against a plain "
                "`jupyter nbconvert --execute` of it (all start a fresh kernel).",
+    "builds": "The instructor's builds of the whole course, each a fresh `python -m coursekit` process: the "
+              "website's two editions from one execution of the notebooks (`site --out A --student-out B`) "
+              "against each edition built alone, and the slides.",
 }
 
 
@@ -313,7 +317,8 @@ def write_docs(path: Path, command: str, report: list[str]) -> None:
 
 def _student_submissions(folder: Path, count: int) -> Path:
     """`count` copies of chapter 1's student edition in `folder` (student ids s01, s02, ...)."""
-    from coursekit.tools.release import read_notebook, student_edition, write_notebook
+    from coursekit.tools.notebooks import read_notebook, write_notebook
+    from coursekit.tools.release import student_edition
     nb = student_edition(read_notebook(ROOT / "notebooks" / "01_representations.ipynb"))
     folder.mkdir(parents=True, exist_ok=True)
     for i in range(1, count + 1):
@@ -355,6 +360,30 @@ def bench_grading(repeat: int, count: int = 6) -> list[str]:
             f"| grader / nbconvert | {med['grade one'] / med['nbconvert']:.2f} | <= 1.3 |"]
 
 
+def _command(*args: str) -> None:
+    subprocess.run([sys.executable, "-m", "coursekit", *args], check=True, capture_output=True, cwd=ROOT)
+
+
+def bench_builds(repeat: int) -> list[str]:
+    """Seconds per build of the course: both site editions from one execution, each alone, the slides."""
+    import tempfile
+    with tempfile.TemporaryDirectory() as tmp:
+        med = interleaved({
+            "both": lambda: _command("site", "--out", f"{tmp}/a", "--student-out", f"{tmp}/b"),
+            "site": lambda: _command("site", "--out", f"{tmp}/a"),
+            "student": lambda: _command("site", "--student", "--out", f"{tmp}/b"),
+            "slides": lambda: _command("slides", "--out", f"{tmp}/s")}, repeat)
+    load = os.getloadavg()[1] if hasattr(os, "getloadavg") else float("nan")
+    alone = med["site"] + med["student"]
+    return ["| build | seconds | target |", "|---|---|---|",
+            f"| machine load average (5 min) at the end, {os.cpu_count()} cores | {load:.1f} | |",
+            f"| `site --out A --student-out B` (both editions) | {med['both']:.0f} | |",
+            f"| `site --out A` (full edition) | {med['site']:.0f} | |",
+            f"| `site --student --out B` | {med['student']:.0f} | |",
+            f"| both editions in one / each alone | {med['both'] / alone:.2f} | <= 0.8 |",
+            f"| `slides --out S` | {med['slides']:.0f} | |"]
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--quick", action="store_true", help="fewer repetitions, skip notebooks")
@@ -366,6 +395,9 @@ def main() -> None:
     parser.add_argument("--grading", action="store_true",
                         help="add the grader benchmark (python -m coursekit grade on chapter 1 copies)")
     parser.add_argument("--grading-only", action="store_true", help="run only the grader benchmark")
+    parser.add_argument("--builds", action="store_true",
+                        help="add the builds of the website (both editions) and the slides")
+    parser.add_argument("--builds-only", action="store_true", help="run only the builds benchmark")
     parser.add_argument("--screenshots", type=Path, default=None, metavar="DIR",
                         help="browser benchmark: save a screenshot of each notebook after its drag")
     parser.add_argument("--docs", action="store_true",
@@ -393,6 +425,11 @@ def main() -> None:
         sections.append(grading_section)
     if args.grading_only:
         sections = [grading_section]
+    builds_section = ("builds: the whole course, fresh processes", bench_builds, 1 if args.quick else 3)
+    if args.builds:
+        sections.append(builds_section)
+    if args.builds_only:
+        sections = [builds_section]
     print(f"coursekit benchmarks, Python {sys.version.split()[0]}, numpy {np.__version__}\n")
     report = [f"Python {sys.version.split()[0]}, numpy {np.__version__}.", ""]
     for title, func, reps in sections:

@@ -130,7 +130,7 @@ def _add_colab(commands) -> None:
 
 def _run_colab(args) -> int:
     from .tools.colab import apply_install_cell, repository_from_git
-    from .tools.release import default_notebook_dir
+    from .tools.notebooks import default_notebook_dir
     folder = args.notebooks or default_notebook_dir()
     repository = args.repository or repository_from_git(folder)
     if repository is None:
@@ -151,8 +151,12 @@ def _add_site(commands) -> None:
                     "python -m http.server -d DIR (or open DIR/index.html).")
     parser.add_argument("--out", required=True, type=Path, metavar="DIR",
                         help="folder to write the site into (an earlier site there is replaced)")
-    parser.add_argument("--student", action="store_true",
-                        help="build from the student edition: exercises without their solutions")
+    edition = parser.add_mutually_exclusive_group()
+    edition.add_argument("--student", action="store_true",
+                         help="build from the student edition: exercises without their solutions")
+    edition.add_argument("--student-out", type=Path, default=None, metavar="DIR2",
+                         help="also build the student edition into DIR2, from the same execution of the "
+                              "notebooks (both editions in the time of one)")
     parser.add_argument("--notebooks", type=Path, default=None, metavar="DIR",
                         help="folder of the chapter notebooks (default: the repository's notebooks/)")
     parser.set_defaults(run=_run_site)
@@ -160,8 +164,10 @@ def _add_site(commands) -> None:
 
 def _run_site(args) -> int:
     from .tools.site import build_site
-    index = build_site(args.out, student=args.student, notebooks_dir=args.notebooks, verbose=True)
-    print(f"site written to {index.parent}\n"
+    index = build_site(args.out, student=args.student, student_out=args.student_out,
+                       notebooks_dir=args.notebooks, verbose=True)
+    also = f" and its student edition to {args.student_out}" if args.student_out else ""
+    print(f"site written to {index.parent}{also}\n"
           f"view it: python -m http.server -b 127.0.0.1 -d {index.parent}  (then open "
           "http://127.0.0.1:8000), or open index.html in a browser")
     return 0

@@ -17,20 +17,20 @@ kernel per core at a time, in kernels of this interpreter.
 
 from __future__ import annotations
 
-import asyncio
+import contextlib
 import copy
-import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import nbformat
 import pytest
 
+from coursekit.tools.notebooks import default_notebook_dir, execute_all, read_notebook
 from coursekit.tools.slideshow import DESCRIBE_FIGURES
 from kernels import this_python_kernel
-from notebook_figures import PRELUDE as FIGURE_CHECKS
+from notebook_figures import PRELUDE as FIGURE_CHECKS, REPORT
 
-__all__ = ["PRELUDE", "Executed", "ExecutedChapters", "replay_into"]
+__all__ = ["PRELUDE", "Executed", "ExecutedChapters", "replay_into", "replaying"]
 
 #: the first cell of the instructor edition: the slides' figure descriptions, the figure checks
 PRELUDE = DESCRIBE_FIGURES + FIGURE_CHECKS
@@ -84,13 +84,12 @@ class ExecutedChapters:
 def _execute_instructor(names: list[str]) -> list:
     """The instructor edition's chapters called `names`, with their slide types, executed after
     the slides' first cell and the figure checks' (`PRELUDE`)."""
-    from coursekit.tools.release import default_notebook_dir
     from coursekit.tools.slides import with_slide_metadata
     paths = [default_notebook_dir() / name for name in names]
-    notebooks = [with_slide_metadata(nbformat.read(path, as_version=4)) for path in paths]
+    notebooks = [with_slide_metadata(read_notebook(path)) for path in paths]
     for nb in notebooks:
         nb.cells.insert(0, nbformat.v4.new_code_cell(PRELUDE))
-    asyncio.run(_execute_all(notebooks, paths))
+    _execute(notebooks, paths)
     return notebooks
 
 
@@ -98,27 +97,15 @@ def _execute_student(folder: Path) -> Executed:
     """The student edition as ``python -m coursekit release`` writes it into `folder`, executed."""
     from coursekit.tools.release import build_release
     paths = build_release(folder)
-    notebooks = [nbformat.read(path, as_version=4) for path in paths]
-    asyncio.run(_execute_all(notebooks, paths))
+    notebooks = [read_notebook(path) for path in paths]
+    _execute(notebooks, paths)
     return Executed(paths, notebooks)
 
 
-async def _execute_all(notebooks: list, paths: list[Path]) -> None:
-    from nbclient import NotebookClient
-    from nbclient.exceptions import CellExecutionError
-    gate = asyncio.Semaphore(os.cpu_count() or 1)
-
-    async def run(nb, path):
-        # store_widget_state=False as the slides and the website execute: explorers keep their PNG
-        client = NotebookClient(nb, km=this_python_kernel(asynchronous=True), timeout=600,
-                                store_widget_state=False, resources={"metadata": {"path": str(path.parent)}})
-        async with gate:
-            try:
-                await client.async_execute()
-            except CellExecutionError as error:
-                raise AssertionError(f"{path.name} failed in a cell:\n{error}") from None
-
-    await asyncio.gather(*(run(nb, path) for nb, path in zip(notebooks, paths)))
+def _execute(notebooks: list, paths: list[Path]) -> None:
+    """Execute as the builds do (`coursekit.tools.notebooks.execute_all`), in kernels of this interpreter."""
+    execute_all(notebooks, paths, timeout=600, what="the tests' shared chapters",
+                kernel=lambda: this_python_kernel(asynchronous=True))
 
 
 def replay_into(nb, executed, *, drop: tuple[str, ...] = ()) -> None:
@@ -136,3 +123,26 @@ def replay_into(nb, executed, *, drop: tuple[str, ...] = ()) -> None:
                 for media in drop:
                     output.get("data", {}).pop(media, None)
     nb.metadata["language_info"] = copy.deepcopy(executed.metadata.get("language_info", {}))
+
+
+@contextlib.contextmanager
+def replaying(executed_chapters: ExecutedChapters):
+    """While open, a build of the slides (``python -m coursekit slides``) executes only the
+    chapters `executed_chapters` has not executed: the others take the outputs of the shared
+    copies (`replay_into`, without the figure checks' reports), which must match them cell by cell."""
+    from coursekit.tools import notebooks
+    execute = notebooks._execute_all
+
+    async def replayed(nbs, sources, **kwargs):
+        rest = []
+        for nb, path in zip(nbs, sources):
+            if executed_chapters.has_instructor(path.name):
+                replay_into(nb, executed_chapters.instructor([path.name])[0], drop=(REPORT,))
+            else:
+                rest.append((nb, path))
+        if rest:
+            await execute([nb for nb, _ in rest], [path for _, path in rest], **kwargs)
+
+    with pytest.MonkeyPatch.context() as patch:
+        patch.setattr(notebooks, "_execute_all", replayed)
+        yield

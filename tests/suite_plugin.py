@@ -22,13 +22,11 @@ __all__ = ["NOTEBOOK_TESTS", "NOTEBOOK_FIXTURES", "SWEEP_MODULES", "browser_skip
 #: the tests that execute notebooks besides nbval's, as "module::test" (every parametrization)
 NOTEBOOK_TESTS = {
     "test_figure_style.py::test_every_figure_a_notebook_shows_is_readable_by_everyone",
-    "test_site.py::test_small_build_instructor_site",
-    "test_site.py::test_small_build_student_site_has_no_solutions",
     "test_site.py::test_the_site_builds_with_every_outside_connection_refused",
     "test_slides.py::test_small_build_from_the_command_line_needs_no_network",
 }
 #: fixtures that execute notebooks (or hand out executed ones): every test using one is marked
-NOTEBOOK_FIXTURES = {"executed_chapters", "release", "graded", "extended"}
+NOTEBOOK_FIXTURES = {"executed_chapters", "release", "graded", "extended", "built", "small_site"}
 
 #: the modules whose tests parametrized over the course's explorers are sweeps
 SWEEP_MODULES = {"test_explorer_frames.py", "test_figure_layout.py", "test_figure_style.py"}

@@ -39,7 +39,7 @@ import numpy as np
 import pytest
 
 import lab_harness as lab_h
-from coursekit.tools.chapters import chapter_notebooks
+from coursekit.tools.notebooks import chapter_notebooks
 
 pytestmark = pytest.mark.browser
 

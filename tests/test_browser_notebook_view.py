@@ -23,7 +23,7 @@ import nbformat
 import pytest
 
 import lab_harness as lab_h
-from coursekit.tools.chapters import chapter_notebooks
+from coursekit.tools.notebooks import chapter_notebooks
 
 pytestmark = pytest.mark.browser
 

@@ -9,7 +9,7 @@ import pytest
 from coursekit.__main__ import main
 from coursekit.tools.colab import (INSTALL_MARK, apply_install_cell, cell_repository, install_cell_source,
                              repository_from_git, with_install_cell)
-from coursekit.tools.release import default_notebook_dir, read_notebook
+from coursekit.tools.notebooks import default_notebook_dir, read_notebook
 
 NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))
 

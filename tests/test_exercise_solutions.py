@@ -24,7 +24,7 @@ from pathlib import Path
 
 import pytest
 
-from coursekit.tools.chapters import chapter_notebooks
+from coursekit.tools.notebooks import chapter_notebooks
 from coursekit.exercises._feedback import CheckResult
 from kernels import this_python_kernel
 

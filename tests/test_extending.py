@@ -55,7 +55,8 @@ def test_the_new_chapter_needs_no_edit_outside_its_own_files(extended):
 
 
 def test_the_new_chapter_is_found_by_the_course_tools(extended):
-    code = ("from coursekit.tools.chapters import explorer_factories, check_functions, chapter_notebooks\n"
+    code = ("from coursekit.tools.chapters import explorer_factories, check_functions\n"
+            "from coursekit.tools.notebooks import chapter_notebooks\n"
             "import coursekit.exercises as ex\n"
             "print(sorted(explorer_factories())[-1], sorted(check_functions())[-1], "
             "chapter_notebooks('notebooks')[-1].name, [e.check for e in ex.chapter_exercises(5)])")

@@ -23,7 +23,7 @@ from matplotlib.colors import to_hex  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 import coursekit as ck  # noqa: E402
-from coursekit.tools.chapters import chapter_notebooks  # noqa: E402
+from coursekit.tools.notebooks import chapter_notebooks  # noqa: E402
 from figure_checks import colour_problems, contrast_problems, curve_problems, style_problems  # noqa: E402
 from notebook_figures import figure_reports  # noqa: E402
 from test_figure_layout import EXPLORERS, FIGURES, settings  # noqa: E402

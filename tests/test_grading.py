@@ -31,7 +31,8 @@ from nbformat.v4 import new_code_cell, new_markdown_cell, new_notebook
 from coursekit.__main__ import main
 from coursekit.exercises._catalog import chapter_exercises
 from coursekit.tools.grading import grade, parse_memory
-from coursekit.tools.release import default_notebook_dir, read_notebook, student_edition
+from coursekit.tools.notebooks import default_notebook_dir, read_notebook
+from coursekit.tools.release import student_edition
 from grading_cases import SANDBOX, answer, exercise_section, solved
 
 CHECKS = [entry.check for entry in chapter_exercises(1)]

@@ -30,7 +30,7 @@ from coursekit.__main__ import main
 from coursekit.exercises._catalog import chapter_exercises
 from coursekit.tools.grading import sandbox as sandbox_module
 from coursekit.tools.grading import SandboxUnavailable, grade
-from coursekit.tools.release import default_notebook_dir, read_notebook
+from coursekit.tools.notebooks import default_notebook_dir, read_notebook
 from grading_cases import SANDBOX, answer, solved
 
 CHECKS = [entry.check for entry in chapter_exercises(1)]

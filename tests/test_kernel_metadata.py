@@ -17,7 +17,8 @@ from coursekit.__main__ import main
 from coursekit.tools.colab import with_install_cell
 from coursekit.tools.kernel_metadata import (KERNEL_KEYS, apply_kernel_metadata, kernel_metadata,
                                              kernelspec_metadata, with_kernel_metadata)
-from coursekit.tools.release import default_notebook_dir, read_notebook, student_edition
+from coursekit.tools.notebooks import default_notebook_dir, read_notebook
+from coursekit.tools.release import student_edition
 from coursekit.tools.slides import with_slide_metadata
 
 NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))

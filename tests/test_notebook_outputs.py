@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from coursekit.tools.chapters import chapter_notebooks
+from coursekit.tools.notebooks import chapter_notebooks
 from notebook_figures import text_outputs
 
 NOTEBOOKS = chapter_notebooks(Path(__file__).resolve().parents[1] / "notebooks")

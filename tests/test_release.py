@@ -15,8 +15,8 @@ import pytest
 
 from coursekit.__main__ import main
 from coursekit.tools.cells import SOLUTION_TAG
-from coursekit.tools.release import (STUDENT_NOTE, build_release, default_notebook_dir,
-                               read_notebook, student_edition)
+from coursekit.tools.notebooks import default_notebook_dir, read_notebook
+from coursekit.tools.release import STUDENT_NOTE, build_release, student_edition
 
 NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))
 
@@ -247,8 +247,8 @@ def test_written_notebooks_validate_and_keep_the_json_style(tmp_path):
 
 def test_default_notebook_folder_without_an_editable_install(tmp_path, monkeypatch):
     # installed with `pip install .` (Binder): the package is not beside notebooks/, the clone is the cwd
-    import coursekit.tools.release as release
-    monkeypatch.setattr(release, "__file__", str(tmp_path / "site-packages" / "coursekit" / "release.py"))
+    import coursekit.tools.notebooks as release
+    monkeypatch.setattr(release, "__file__", str(tmp_path / "site-packages" / "coursekit" / "tools" / "notebooks.py"))
     monkeypatch.chdir(tmp_path)
     assert release.default_notebook_dir() == tmp_path / "notebooks"
     monkeypatch.undo()

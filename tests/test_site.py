@@ -22,7 +22,7 @@ import nbformat
 import pytest
 
 from coursekit.tools import site
-from coursekit.tools.chapters import chapter_notebooks
+from coursekit.tools.notebooks import ALT, WIDGET_VIEW, chapter_notebooks
 from coursekit.tools.kernel_metadata import kernelspec_metadata
 from coursekit.__main__ import main
 
@@ -90,24 +90,12 @@ def test_erratum_admonitions_refuses_non_text():
 
 # --- notebook rewrites ---------------------------------------------------------------------
 
-def _widget_output(with_png=True):
-    data = {site.WIDGET_VIEW: {"model_id": "abc", "version_major": 2, "version_minor": 0},
-            "text/plain": "Explorer"}
-    if with_png:
-        data["image/png"] = "iVBORw0KGgo="
-    return nbformat.v4.new_output("display_data", data=data)
-
-
-def test_strip_widget_views_keeps_the_static_figure():
-    nb = nbformat.v4.new_notebook()
-    nb.metadata["widgets"] = {"application/vnd.jupyter.widget-state+json": {}}
-    nb.cells = [_code("explorer()", outputs=[_widget_output()]),
-                _code("w", outputs=[nbformat.v4.new_output("display_data", data={site.WIDGET_VIEW: {}})]),
-                _markdown("text")]
-    site.strip_widget_views(nb)
-    assert set(nb.cells[0].outputs[0]["data"]) == {"image/png", "text/plain"}
-    assert nb.cells[1].outputs == []
-    assert "widgets" not in nb.metadata
+def test_the_pages_show_no_widget_view_but_the_figure_or_text_beside_it():
+    from myst_nb.core.render import get_mime_priority
+    conf = {}
+    exec(site.sphinx_conf(title="t"), conf)     # the configuration Sphinx runs
+    shown = get_mime_priority("html", conf["nb_mime_priority_overrides"])
+    assert WIDGET_VIEW not in shown and shown.index("image/png") < shown.index("text/plain")
 
 
 def test_fold_solution_code_folds_only_solution_code_cells():
@@ -142,14 +130,14 @@ def test_chapter_entry_needs_a_title():
 def test_landing_page_has_a_row_and_a_toctree_entry_per_chapter():
     chapters = [{"number": "1", "title": "One", "page": "01_one", "sections": ["1.1 A", "1.2 B"]},
                 {"number": "2", "title": "Two", "page": "02_two", "sections": []}]
-    text = site.landing_page(chapters, run_online="Open the [course online](https://example.org).")
+    text = site.landing_page(chapters)
     assert "| 1 | [One](01_one.ipynb) | 1.1 A · 1.2 B |" in text
     assert "| 2 | [Two](02_two.ipynb) |  |" in text
     assert re.search(r"```\{toctree\}\n:hidden:\n:maxdepth: 2\n\n01_one\n02_two\n```", text)
     assert 'python -m pip install -e ".[lab]"' in text and "python -m jupyterlab notebooks/" in text
-    assert "### Run online" in text and "worked solution, folded" in text
+    assert "worked solution, folded" in text
     student = site.landing_page(chapters, student=True)
-    assert "student edition" in student and "Run online" not in student
+    assert "student edition" in student
 
 
 def test_chapter_notebooks_are_found_in_order_and_bad_folders_refused(tmp_path):
@@ -166,10 +154,16 @@ def test_chapter_notebooks_are_found_in_order_and_bad_folders_refused(tmp_path):
     ({"verbose": 1}, TypeError, "verbose must be True or False"),
     ({"timeout": 0}, ValueError, "timeout must be a positive"),
     ({"timeout": 2.5}, ValueError, "timeout must be a positive"),
+    ({"student": True, "student_out": "s"}, ValueError, "pass student=False"),
 ])
 def test_build_site_checks_its_arguments(tmp_path, kwargs, error, match):
     with pytest.raises(error, match=match):
         site.build_site(tmp_path / "out", **kwargs)
+
+
+def test_build_site_refuses_one_folder_for_both_editions(tmp_path):
+    with pytest.raises(ValueError, match="student_out .* is out_dir"):
+        site.build_site(tmp_path / "out", student_out=tmp_path / "out", notebooks_dir=NOTEBOOKS)
 
 
 def test_build_site_refuses_to_write_over_the_notebooks(tmp_path):
@@ -226,27 +220,42 @@ SMALL_NOTEBOOK = [
 ]
 
 
-def _small_build(tmp_path, student):
+def _counted(name: str) -> list:
+    """A chapter's title and a cell that notes each execution in runs-NAME.log of its folder."""
+    return [_markdown(f"# Chapter {int(name)} — chapter {name}"),
+            _code(f"_ = open('runs-{name}.log', 'a').write('run\\n')")]
+
+
+@pytest.fixture(scope="module")
+def small_site(tmp_path_factory):
+    """The small chapter (and a tiny one with no solution in code) built in both editions by one
+    call: ``({False: (index, page), True: (index, page)}, {chapter: times executed})``."""
     missing = site.missing_site_tools()
     if missing:
         pytest.skip("the site extra is not installed (missing: " + ", ".join(missing) + ")")
-    folder = tmp_path / "nb"
-    folder.mkdir(exist_ok=True)
-    nb = nbformat.v4.new_notebook()
-    nb.metadata["kernelspec"] = kernelspec_metadata()
-    nb.cells = SMALL_NOTEBOOK
-    nbformat.write(nb, folder / "07_small.ipynb")
-    index = site.build_site(tmp_path / ("student" if student else "site"), student=student,
-                            notebooks_dir=folder)
-    return index, (index.parent / "07_small.html").read_text(encoding="utf-8")
+    root = tmp_path_factory.mktemp("small")
+    folder = root / "nb"
+    folder.mkdir()
+    for name, cells in [("07_small", SMALL_NOTEBOOK + _counted("07")[1:]), ("08_tiny", _counted("08"))]:
+        nb = nbformat.v4.new_notebook(cells=cells)
+        nb.metadata["kernelspec"] = kernelspec_metadata()
+        nbformat.write(nb, folder / f"{name}.ipynb")
+    index = site.build_site(root / "site", student_out=root / "student", notebooks_dir=folder)
+    editions = {False: index, True: root / "student" / "index.html"}
+    runs = {name: (folder / f"runs-{name}.log").read_text().count("run") for name in ("07", "08")}
+    return {student: (i, (i.parent / "07_small.html").read_text(encoding="utf-8")) for student, i in editions.items()}, runs
+
+
+def test_small_build_both_editions_from_one_execution_unless_a_solution_is_code(small_site):
+    assert small_site[1] == {"07": 2, "08": 1}
 
 
 def _text(page: str) -> str:
     return html.unescape(re.sub(r"<[^>]+>", "", page))
 
 
-def test_small_build_instructor_site(tmp_path):
-    index, page = _small_build(tmp_path, student=False)
+def test_small_build_instructor_site(small_site):
+    index, page = small_site[0][False]
     out = index.parent
     assert "07_small.html" in index.read_text(encoding="utf-8")
     # math: typeset by the MathJax copied into the site, loaded from there
@@ -256,7 +265,7 @@ def test_small_build_instructor_site(tmp_path):
     assert '<span class="math' in page
     assert '<span class="math notranslate nohighlight">\\(= 42\\)</span>' in page   # math in markdown output
     # the explorer: its static figure, no widget view
-    assert re.search(r'<img[^>]*src="_images/', page) and site.WIDGET_VIEW not in page
+    assert re.search(r'<img[^>]*src="_images/', page) and WIDGET_VIEW not in page
     # the erratum box
     assert '<div class="erratum admonition">' in page and "**Erratum" not in page
     # both kinds of solution, folded
@@ -276,10 +285,10 @@ def test_small_build_instructor_site(tmp_path):
               for src in re.findall(r'<img[^>]*src="(_images/[^"]*)"', page)}
     sizes = [record.get(digest) for digest in images.values()]
     assert len(sizes) == 2 and 10.0 in sizes and None in sizes, (images, record)
-    assert site.SMALLEST_TEXT not in page and site.ALT not in page
+    assert site.SMALLEST_TEXT not in page and ALT not in page
     # no setup cell, placeholder or build-machine output; the notebook to download, stored clean
     assert "OWNER/NAME" not in page and "BUILD-MACHINE-VERSIONS" not in page
-    assert "Run online" not in index.read_text(encoding="utf-8")     # no repository address yet
+    assert "mybinder" not in page and "colab" not in page and "github.com" not in page  # no address yet
     link = re.search(r'<a[^>]*href="(_downloads/[^"]*07_small\.ipynb)"', page)
     assert link, "no download link to the chapter's notebook"
     downloaded = nbformat.read(out / link.group(1), as_version=4)
@@ -289,8 +298,8 @@ def test_small_build_instructor_site(tmp_path):
     assert "downloads/" not in (out / "searchindex.js").read_text(encoding="utf-8")
 
 
-def test_small_build_student_site_has_no_solutions(tmp_path):
-    index, page = _small_build(tmp_path, student=True)
+def test_small_build_student_site_has_no_solutions(small_site):
+    index, page = small_site[0][True]
     link = re.search(r'<a[^>]*href="(_downloads/[^"]*07_small\.ipynb)"', page)
     downloaded = (index.parent / link.group(1)).read_text(encoding="utf-8")
     assert "SOLUTION" not in downloaded and "answer = None" in downloaded   # the student edition
@@ -299,15 +308,18 @@ def test_small_build_student_site_has_no_solutions(tmp_path):
     assert "SOLUTION" not in _text(page) and "Show solution" not in page
 
 
-@pytest.mark.parametrize("repository, links", [
-    (None, []), ("https://github.com/OWNER", []), ("https://gitlab.com/a/b", []),
-    ("https://github.com/uni-x/control-course", ["https://mybinder.org/v2/gh/uni-x/control-course/HEAD",
-                                                 "https://colab.research.google.com/github/uni-x/control-course",
-                                                 "https://github.com/uni-x/control-course"]),
+@pytest.mark.parametrize("repository, github", [
+    (None, None), ("https://github.com/OWNER", None), ("https://gitlab.com/a/b", None),
+    ("https://github.com/uni-x/control-course.git", "https://github.com/uni-x/control-course"),
 ])
-def test_run_online_links_appear_only_with_a_repository_address(repository, links):
-    text = site.run_online(repository)
-    assert all(link in text for link in links) and (bool(text) == bool(links))
+def test_repository_and_launch_buttons_appear_only_with_a_repository_address(repository, github):
+    conf = {}
+    exec(site.sphinx_conf(title="t", repository=repository), conf)     # the configuration Sphinx runs
+    options = conf["html_theme_options"]
+    assert options["use_repository_button"] == bool(github) and ("launch_buttons" in options) == bool(github)
+    if github:
+        assert options["repository_url"] == github and options["path_to_docs"] == "notebooks"
+        assert set(options["launch_buttons"]) >= {"binderhub_url", "colab_url"}
 
 
 #: put before the build's own Python processes (the build, the kernels, Sphinx): every connection

@@ -32,7 +32,7 @@ import pytest
 from PIL import Image
 
 from coursekit.tools import site
-from coursekit.tools.chapters import chapter_notebooks
+from coursekit.tools.notebooks import chapter_notebooks
 
 import lab_harness  # the browser test's Chromium location and settings
 import static_explorer_checks  # the explorers' sliders on a static page

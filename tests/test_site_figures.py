@@ -25,6 +25,7 @@ from PIL import Image  # noqa: E402
 
 from coursekit.explorers import ch1  # noqa: E402
 from coursekit.tools import site, site_figures  # noqa: E402
+from coursekit.tools.notebooks import ALT  # noqa: E402
 from coursekit.tools.site_figures import COLUMN_PX, MIN_TEXT_PX, column_zoom, drawn_for_the_column  # noqa: E402
 
 SMALL = 10 * 0.833       # matplotlib's "small" font size at its default 10 points
@@ -77,7 +78,7 @@ def test_the_site_kernel_gives_a_figure_its_png_for_the_column_description_and_s
     assert png.size == (1300, 400)
     assert png.info["dpi"][0] == pytest.approx(100 * column_zoom(fig), rel=1e-3)
     assert float(data[site.SMALLEST_TEXT]) == pytest.approx(SMALL, abs=0.01)
-    assert data[site.ALT].startswith("The plot (a figure) shows x1 [m] against time t [s]")
+    assert data[ALT].startswith("The plot (a figure) shows x1 [m] against time t [s]")
     assert tuple(fig.get_size_inches()) == (13.0, 4.0) and fig.dpi == 100
 
 
@@ -89,5 +90,5 @@ def test_the_site_kernel_draws_an_explorer_for_the_column_too():
     png = _png(data["image/png"])
     assert png.size == (1100, 450) and png.info["dpi"][0] == pytest.approx(100 * zoom, rel=1e-3)
     assert float(data[site.SMALLEST_TEXT]) == pytest.approx(SMALL, abs=0.01)
-    assert site.ALT not in data and "Mass-spring-damper" in data["text/plain"]     # its own description
+    assert ALT not in data and "Mass-spring-damper" in data["text/plain"]     # its own description
     assert explorer.png == explorer.static_png()               # and it is its natural self again

@@ -24,16 +24,13 @@ import nbformat
 import pytest
 
 from coursekit.__main__ import main
-from coursekit.tools import slideshow
-from coursekit.tools.chapters import chapter_notebooks
-from coursekit.tools.release import default_notebook_dir, read_notebook
-from coursekit.tools.site import ALT, WIDGET_VIEW
+from coursekit.tools import notebooks as notebook_module, slideshow
+from coursekit.tools.notebooks import ALT, WIDGET_VIEW, chapter_notebooks, default_notebook_dir, read_notebook
 from coursekit.tools.slides import apply_slide_metadata, slide_types, with_slide_metadata
 
 import lab_harness  # the browser tests' Chromium location, settings and axe-core
 import static_explorer_checks  # the explorers' sliders on a static page
-from executed_chapters import replay_into
-from notebook_figures import REPORT
+from executed_chapters import replaying
 
 NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))
 
@@ -151,7 +148,7 @@ def test_figures_get_their_text_alternative_from_their_data():
         WIDGET_VIEW: {"model_id": "m1", "version_major": 2, "version_minor": 0}})
     printed = nbformat.v4.new_output("stream", text="no figure here")
     nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell("", outputs=[figure, explorer, printed])])
-    slideshow.figure_alt_texts(nb)
+    notebook_module.harvest_alt_texts(nb)
     assert figure.metadata["image/png"]["alt"] == "Step response: y rises from 0 to 1 in 2 s."
     assert ALT not in figure.data                   # not a type the page could show
     assert explorer.metadata["image/png"]["alt"] == "Euler explorer: step h = 0.1 s, error 3 %"
@@ -288,20 +285,9 @@ def course(tmp_path_factory, executed_chapters):
     if reason:
         pytest.skip(reason)
     _skip_without_slide_tools()
-    execute = slideshow._execute_all
-
-    async def replayed(notebooks, sources, **kwargs):
-        for nb, path in zip(notebooks, sources):
-            if executed_chapters.has_instructor(path.name):
-                replay_into(nb, executed_chapters.instructor([path.name])[0], drop=(REPORT,))
-        rest = [(nb, path) for nb, path in zip(notebooks, sources) if not executed_chapters.has_instructor(path.name)]
-        if rest:
-            await execute([nb for nb, _ in rest], [path for _, path in rest], **kwargs)
-
     out = tmp_path_factory.mktemp("slides") / "slides"
     start = time.monotonic()
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(slideshow, "_execute_all", replayed)
+    with replaying(executed_chapters):
         assert main(["slides", "--out", str(out)]) == 0
     print(f"\nslides of {len(CHAPTERS)} chapters built in {time.monotonic() - start:.0f} s")
     return out

@@ -1,9 +1,9 @@
 """The course's tools, beside its algorithms: for instructors and maintainers, not for students.
 
-* `chapters` lists the chapters' notebooks, explorers and checks (the modules come from
-  `coursekit._chapters`); `cells` names the roles of a notebook's cells that the other tools
-  read; `builds` holds what the builds share; `kernel_metadata` stores the notebooks' kernel
-  entries;
+* `notebooks` finds, reads, writes and executes the chapter notebooks and gives their figures
+  their text alternatives, for every tool below; `chapters` lists the chapters' explorers and
+  checks (the modules come from `coursekit._chapters`); `cells` names the roles of a notebook's
+  cells that the other tools read; `builds` holds what the builds share;
 * `release` writes the student edition, `slides` the slide metadata, `colab` the install cell;
 * `site` builds the course website (`site_figures` draws its figures for the page,
   `static_explorers` renders the explorers' frames for pages without a kernel), `slideshow`

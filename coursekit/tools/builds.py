@@ -11,8 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Callable
 
-from .chapters import chapter_notebooks
-from .release import default_notebook_dir
+from .notebooks import chapter_notebooks, default_notebook_dir
 
 __all__ = ["start_build", "check_out_dir"]
 

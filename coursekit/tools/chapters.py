@@ -1,6 +1,7 @@
 """The course's chapters, found rather than listed.
 
-A chapter is a notebook ``NN_name.ipynb`` in ``notebooks/`` and, when it has them, a module
+A chapter is a notebook ``NN_name.ipynb`` in ``notebooks/`` (`coursekit.tools.notebooks` finds
+them) and, when it has them, a module
 ``chN`` in `coursekit.explorers` (its explorers: public functions named ``*_explorer``) and
 one in `coursekit.exercises` (its exercises: public functions named ``check_*``). The tests,
 the benchmarks, the release, the website and the slides take the chapters from here, so a
@@ -10,12 +11,11 @@ fifth chapter is picked up by all of them without an edit.
 from __future__ import annotations
 
 import inspect
-from pathlib import Path
 from typing import Callable
 
 from .._chapters import chapter_modules
 
-__all__ = ["chapter_modules", "explorer_factories", "check_functions", "chapter_notebooks"]
+__all__ = ["chapter_modules", "explorer_factories", "check_functions"]
 
 
 def _public_functions(package: str, test: Callable[[str], bool]) -> dict[str, Callable]:
@@ -37,15 +37,3 @@ def check_functions() -> dict[str, Callable]:
     """Every exercise check of the course: ``{"ch1.check_msd_state_space": ..., ...}``."""
     return _public_functions("exercises", lambda name: name.startswith("check_"))
 
-
-def chapter_notebooks(notebooks_dir) -> list[Path]:
-    """The chapter notebooks (``01_*.ipynb``, ``02_*.ipynb``, ...) of `notebooks_dir`, in order."""
-    folder = Path(notebooks_dir)
-    if not folder.is_dir():
-        raise ValueError(f"notebooks_dir {str(folder)!r} is not a directory; pass the folder "
-                         "that holds the chapter notebooks (notebooks/ in the repository)")
-    found = sorted(p for p in folder.glob("[0-9]*.ipynb") if p.is_file())
-    if not found:
-        raise ValueError(f"notebooks_dir {str(folder)!r} holds no chapter notebook "
-                         "(files named like 01_representations.ipynb)")
-    return found

@@ -20,7 +20,7 @@ import subprocess
 from pathlib import Path
 
 from .cells import ENVIRONMENT, INSTALL, ROLE_KEY, role
-from .release import notebook_paths, read_notebook, write_notebook
+from .notebooks import update_notebooks
 
 __all__ = ["INSTALL_MARK", "install_cell_source", "cell_repository", "with_install_cell",
            "apply_install_cell", "repository_from_git"]
@@ -120,14 +120,9 @@ def apply_install_cell(notebooks: Path | str | None = None, *, repository: str |
     `notebooks` defaults to the repository's ``notebooks/``; ``write=False``
     only reports which notebooks would change.
     """
-    install_cell_source(repository)   # validates the address before anything is written
-    _, paths = notebook_paths(notebooks)
-    changed = []
-    for path in paths:
-        nb = read_notebook(path)
+    source = install_cell_source(repository)   # validates the address before anything is written
+
+    def stale(nb) -> bool:
         index = _install_cell_index(nb)
-        if index is None or nb.cells[index].source != install_cell_source(repository):
-            changed.append(path)
-            if write:
-                write_notebook(with_install_cell(nb, repository=repository), path)
-    return changed
+        return index is None or nb.cells[index].source != source
+    return update_notebooks(notebooks, stale, lambda nb: with_install_cell(nb, repository=repository), write=write)

@@ -25,7 +25,7 @@ from __future__ import annotations
 import copy
 from pathlib import Path
 
-from .release import notebook_paths, read_notebook, write_notebook
+from .notebooks import update_notebooks
 
 __all__ = ["COURSE_KERNEL", "KERNEL_KEYS", "kernelspec_metadata", "kernel_language_info",
            "kernel_metadata", "with_kernel_metadata", "apply_kernel_metadata"]
@@ -87,15 +87,6 @@ def apply_kernel_metadata(notebooks: Path | str | None = None, *, write: bool = 
     """Store `metadata` (default: `kernel_metadata()` of this environment) in every notebook of
     the folder `notebooks` (default: the repository's ``notebooks/``); return the notebooks
     whose stored entries differ. With ``write=False`` nothing is written."""
-    if not isinstance(write, bool):
-        raise TypeError(f"write must be True or False: received {write!r}.")
-    _, paths = notebook_paths(notebooks)
     metadata = kernel_metadata() if metadata is None else metadata
-    changed = []
-    for path in paths:
-        nb = read_notebook(path)
-        if any(nb.metadata.get(key) != metadata.get(key) for key in KERNEL_KEYS):
-            changed.append(path)
-            if write:
-                write_notebook(with_kernel_metadata(nb, metadata), path)
-    return changed
+    return update_notebooks(notebooks, lambda nb: any(nb.metadata.get(key) != metadata.get(key) for key in KERNEL_KEYS),
+                            lambda nb: with_kernel_metadata(nb, metadata), write=write)

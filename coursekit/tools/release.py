@@ -18,8 +18,8 @@ The exercises and their ``check_*`` cells stay: run on an unanswered exercise,
 a check prints its "Not yet" feedback, so the edition runs top to bottom
 without errors (tests/test_release.py builds it and executes every notebook).
 
-nbformat (installed with JupyterLab, the ``lab`` extra) is imported inside the
-functions, so ``import coursekit`` does not need it.
+nbformat and nbconvert (installed with JupyterLab, the ``lab`` extra) are imported
+inside the functions, so ``import coursekit`` does not need them.
 """
 
 from __future__ import annotations
@@ -28,16 +28,14 @@ import copy
 import re
 from pathlib import Path
 
-from .cells import EXERCISE, is_solution, role
+from .cells import EXERCISE, SOLUTION_TAG, role
+from .notebooks import notebook_paths, read_notebook, write_notebook
 
 __all__ = [
     "STUDENT_NOTE",
+    "student_text",
     "student_edition",
     "build_release",
-    "default_notebook_dir",
-    "notebook_paths",
-    "read_notebook",
-    "write_notebook",
 ]
 
 
@@ -54,55 +52,6 @@ _POINTER = re.compile(rf"\bsolutions?\b.*\b{_WHERE}\b|\b{_WHERE}\b.*\bsolutions?
 _TRY_FIRST = re.compile(r"^\W*try\b[\w ]{0,25}\bfirst\W*$", re.IGNORECASE)
 _NEGATION = re.compile(r"\b(never|not|no)\b", re.IGNORECASE)
 _SENTENCE_END = re.compile(r"(?<=[.!?])\s+(?=\S)")
-
-
-def _nbformat():
-    try:
-        import nbformat
-    except ImportError as error:  # pragma: no cover - nbformat comes with the lab extra
-        raise ImportError("the student edition needs nbformat, which comes with JupyterLab: "
-                          'python -m pip install -e ".[lab]"') from error
-    return nbformat
-
-
-def default_notebook_dir() -> Path:
-    """The repository's ``notebooks/`` folder (the instructor edition).
-
-    The folder next to the package when coursekit is installed from a clone
-    with ``pip install -e``; otherwise (``pip install .``, as on Binder)
-    ``notebooks/`` in the current folder.
-    """
-    beside = Path(__file__).resolve().parents[2] / "notebooks"
-    return beside if beside.is_dir() else Path.cwd() / "notebooks"
-
-
-def notebook_paths(notebooks=None) -> tuple[Path, list[Path]]:
-    """The folder of the course notebooks (`notebooks`, default `default_notebook_dir`) and its
-    ``*.ipynb`` files, sorted; ValueError when it holds none, TypeError when `notebooks` is
-    not a path."""
-    if notebooks is not None and not isinstance(notebooks, (str, Path)):
-        raise TypeError(f"notebooks must be a folder path (str or Path) or None: received "
-                        f"{type(notebooks).__name__}.")
-    folder = default_notebook_dir() if notebooks is None else Path(notebooks)
-    paths = sorted(folder.glob("*.ipynb"))
-    if not paths:
-        raise ValueError(f"no notebooks (*.ipynb) found in {folder}; pass the folder of the course "
-                         "notebooks (--notebooks on the command line).")
-    return folder, paths
-
-
-def read_notebook(path: Path | str):
-    """Read a notebook file (nbformat 4) into a NotebookNode."""
-    return _nbformat().read(str(path), as_version=4)
-
-
-def write_notebook(nb, path: Path | str) -> None:
-    """Write a notebook in the repository's JSON style (indent 1, sorted keys, final newline)."""
-    Path(path).write_text(_nbformat().writes(nb) + "\n", encoding="utf-8")
-
-
-def _is_solution(cell) -> bool:
-    return is_solution(cell)
 
 
 def _without_solution_pointers(text: str) -> str:
@@ -123,34 +72,42 @@ def _without_solution_pointers(text: str) -> str:
 
 
 def _add_note(nb) -> None:
-    nbformat = _nbformat()
+    from nbformat.v4 import new_markdown_cell
     first = nb.cells[0] if nb.cells else None
     if first is not None and first.cell_type == "markdown":
         if STUDENT_NOTE not in first.source:
             first.source = first.source.rstrip() + "\n\n" + STUDENT_NOTE
     else:
-        nb.cells.insert(0, nbformat.v4.new_markdown_cell(STUDENT_NOTE))
+        nb.cells.insert(0, new_markdown_cell(STUDENT_NOTE))
+
+
+def student_text(nb):
+    """A copy of `nb` with the student edition's cells and text, its outputs kept: the cells
+    tagged ``solution`` removed (nbconvert's ``TagRemovePreprocessor``), the exercise section's
+    pointers to them dropped and the note added to the first cell; `nb` is unchanged."""
+    from nbconvert.preprocessors import TagRemovePreprocessor
+    if not hasattr(nb, "cells") or not hasattr(nb, "metadata"):
+        raise TypeError(f"nb must be a notebook (nbformat NotebookNode): received {type(nb).__name__}; "
+                        "read it with coursekit.tools.notebooks.read_notebook(path).")
+    nb, _ = TagRemovePreprocessor(remove_cell_tags={SOLUTION_TAG}).preprocess(copy.deepcopy(nb), {})
+    for cell in nb.cells:
+        if cell.cell_type == "markdown" and role(cell) == EXERCISE:
+            cell.source = _without_solution_pointers(cell.source)
+    _add_note(nb)
+    return nb
 
 
 def student_edition(nb):
-    """A copy of the notebook `nb` for students (see the module docstring); `nb` is unchanged.
+    """A copy of the notebook `nb` for students (see the module docstring); `nb` is unchanged:
+    `student_text` with every output cleared (nbconvert's ``ClearOutputPreprocessor``) and no
+    widget state.
 
     `nb` is a NotebookNode (from `read_notebook` or ``nbformat.read``). Applying
     it to a student edition again changes nothing.
     """
-    if not hasattr(nb, "cells") or not hasattr(nb, "metadata"):
-        raise TypeError(f"nb must be a notebook (nbformat NotebookNode): received {type(nb).__name__}; "
-                        "read it with coursekit.tools.release.read_notebook(path).")
-    nb = copy.deepcopy(nb)
-    nb.cells = [cell for cell in nb.cells if not _is_solution(cell)]
-    for cell in nb.cells:
-        if cell.cell_type == "code":
-            cell.outputs = []
-            cell.execution_count = None
-        elif cell.cell_type == "markdown" and role(cell) == EXERCISE:
-            cell.source = _without_solution_pointers(cell.source)
+    from nbconvert.preprocessors import ClearOutputPreprocessor
+    nb, _ = ClearOutputPreprocessor().preprocess(student_text(nb), {})
     nb.metadata.pop("widgets", None)
-    _add_note(nb)
     return nb
 
 

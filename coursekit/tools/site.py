@@ -3,9 +3,11 @@
 ``python -m coursekit site --out DIR`` calls :func:`build_site`. The build runs in a temporary
 directory and needs no network:
 
-1. copy the chapter notebooks (for ``student=True`` the student edition: solutions removed);
-2. execute each one with nbclient, without storing widget state, and drop the widget views
-   from the outputs, so that no empty widget area is left; the kernel draws every figure
+1. read the chapter notebooks (`coursekit.tools.notebooks`);
+2. execute each one once for both editions (`coursekit.tools.notebooks.execute_all`; the
+   student edition, `coursekit.tools.release.student_text`, is the executed notebook without its
+   solutions, unless a solution is code); MyST-NB shows no widget view
+   (``nb_mime_priority_overrides``), which would be an empty area; the kernel draws every figure
    for the page's column, so that its smallest text is 11 CSS px or more at a 1,280-px window,
    describes it for its ``alt`` and notes the size of its smallest text, which the site
    records in ``_static/coursekit-figures.json`` (`coursekit.tools.site_figures`); it also
@@ -25,10 +27,9 @@ need them.
 
 from __future__ import annotations
 
-import concurrent.futures
+import copy
 import importlib.util
 import json
-import multiprocessing
 import os
 import re
 import shutil
@@ -38,27 +39,29 @@ import tempfile
 from pathlib import Path
 
 from . import static_explorers
-from .cells import ENVIRONMENT, INSTALL, is_solution, role
 from .builds import start_build
+from .cells import ENVIRONMENT, INSTALL, is_solution, role
+from .notebooks import (WIDGET_VIEW, execute_all, harvest_alt_texts, read_notebook, say, text_of,
+                        write_notebook)
+from .release import student_edition, student_text
 
 __all__ = [
     "build_site",
     "erratum_admonitions",
     "fold_solution_code",
-    "strip_widget_views",
     "chapter_entry",
     "landing_page",
     "sphinx_conf",
     "missing_site_tools",
     "repository_of",
     "for_the_site",
-    "run_online",
-    "describe_images",
+    "github_repository",
+    "SMALLEST_TEXT",
+    "FIGURE_RECORD",
+    "SITE_FIGURES",
     "figure_text_sizes",
     "WIDGET_VIEW", "ALT", "SMALLEST_TEXT",
 ]
-
-WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
 
 #: the theme's search button says "Search" to a screen reader but shows "Search ... Ctrl+K": its
 #: accessible name becomes the text it shows (WCAG 2.5.3, label in name)
@@ -112,29 +115,6 @@ def missing_site_tools() -> list[str]:
             if importlib.util.find_spec(module) is None]
 
 
-def strip_widget_views(nb):
-    """Remove the widget views from every output of `nb` (in place) and return `nb`.
-
-    Without a kernel a widget view renders as an empty area; the explorers also carry a static
-    ``image/png`` in the same output, which is what the site shows. An output left with no data
-    at all is dropped.
-    """
-    for cell in nb.cells:
-        if cell.get("cell_type") != "code":
-            continue
-        kept = []
-        for output in cell.get("outputs", []):
-            data = output.get("data")
-            if data is not None and WIDGET_VIEW in data:
-                del data[WIDGET_VIEW]
-                if not data:
-                    continue
-            kept.append(output)
-        cell["outputs"] = kept
-    nb.metadata.pop("widgets", None)
-    return nb
-
-
 def fold_solution_code(nb):
     """Fold every code cell tagged ``solution`` behind a "Show solution" click (in place).
 
@@ -158,81 +138,42 @@ def erratum_admonitions(markdown: str) -> str:
     An erratum is a paragraph, or a paragraph of a blockquote, that starts with a bold lead
     ``**Erratum ...**`` or ``**Remark / erratum ...**``. The lead becomes the box's title. In a
     blockquote, the paragraphs after an erratum up to the next erratum belong to it; outside a
-    blockquote the box holds that one paragraph. Everything else is returned unchanged.
+    blockquote the box holds that one paragraph (and the block it announces when it ends in ":").
+    Everything else is returned unchanged. The blocks are markdown-it-py's.
     """
     if not isinstance(markdown, str):
         raise TypeError(f"markdown must be a str, got {type(markdown).__name__}")
-    out: list[str] = []
-    for block, quoted in _blocks(markdown.split("\n")):
-        out.extend(_rewrite_block(block, quoted))
-    return "\n".join(out)
+    from markdown_it import MarkdownIt
+    lines, out, done = markdown.split("\n"), [], 0
+    tokens = MarkdownIt("commonmark").parse(markdown)
+    blocks = [t for t in tokens if t.level == 0 and t.map]
+    i = 0
+    while i < len(blocks):
+        (start, end), lead = blocks[i].map, _ERRATUM_LEAD.match(lines[blocks[i].map[0]])
+        out.extend(lines[done:start])
+        if blocks[i].type == "paragraph_open" and lead:
+            # a paragraph ending in ":" announces what follows (say a displayed equation): keep it
+            while lines[end - 1].rstrip().endswith(":") and i + 1 < len(blocks):
+                i, end = i + 1, blocks[i + 1].map[1]
+            out.extend(_admonition(lead, lines[start:end]))
+        elif blocks[i].type == "blockquote_open":
+            out.extend(_quote(lines, start, end, [t.map for t in tokens if t.level == 1 and t.map
+                                                  and start <= t.map[0] < end]))
+        else:
+            out.extend(lines[start:end])
+        done, i = end, i + 1
+    return "\n".join(out + lines[done:])
 
 
-def _blocks(lines):
-    """Split lines into runs of blockquote lines and runs of other lines (code fences kept whole)."""
-    block, quoted, fenced = [], None, False
-    for line in lines:
-        if line.lstrip().startswith("```"):
-            fenced = not fenced
-        is_quote = not fenced and line.startswith(">")
-        if block and is_quote != quoted:
-            yield block, quoted
-            block = []
-        block.append(line)
-        quoted = is_quote
-    if block:
-        yield block, quoted
-
-
-def _rewrite_block(lines, quoted):
-    if quoted:
-        body = [re.sub(r"^> ?", "", line) for line in lines]
-        paragraphs = _paragraphs(body)
-        if not any(_ERRATUM_LEAD.match(p[0]) for p in paragraphs):
-            return lines
-        return _quote_admonitions(paragraphs)
-    out, groups, i = [], _paragraphs(lines, keep_blank=True), 0
-    while i < len(groups):
-        lead = _ERRATUM_LEAD.match(groups[i][0])
-        if not lead:
-            out.extend(groups[i])
-            i += 1
-            continue
-        box = groups[i]
-        i += 1
-        # a paragraph ending in ":" announces what follows (say a displayed equation): keep it
-        while box[-1].rstrip().endswith(":") and i + 1 < len(groups) and not groups[i][0].strip():
-            box = box + groups[i] + groups[i + 1]
-            i += 2
-        out.extend(_admonition(lead, box))
-    return out
-
-
-def _paragraphs(lines, keep_blank=False):
-    """Group lines into paragraphs (a fenced code block stays whole); with keep_blank the blank
-    lines between paragraphs are groups of their own."""
-    groups, current, fenced = [], [], False
-    for line in lines:
-        if line.lstrip().startswith("```"):
-            fenced = not fenced
-        if line.strip() or fenced:
-            current.append(line)
-            continue
-        if current:
-            groups.append(current)
-            current = []
-        if keep_blank:
-            groups.append([line])
-    if current:
-        groups.append(current)
-    return groups
-
-
-def _quote_admonitions(paragraphs):
-    """Blockquote paragraphs -> admonitions; an erratum's box keeps its following paragraphs."""
+def _quote(lines: list[str], start: int, end: int, maps: list) -> list[str]:
+    """The blockquote `lines[start:end]` (its blocks at `maps`) with its errata as admonitions; an
+    erratum's box keeps the quote's following blocks up to the next erratum."""
+    unquoted = [re.sub(r"^> ?", "", line) for line in lines]
+    if not any(_ERRATUM_LEAD.match(unquoted[a]) for a, _ in maps):
+        return lines[start:end]
     out, box = [], None
-    for paragraph in paragraphs:
-        lead = _ERRATUM_LEAD.match(paragraph[0])
+    for a, b in maps:
+        paragraph, lead = unquoted[a:b], _ERRATUM_LEAD.match(unquoted[a])
         if lead:
             if box:
                 out.extend(_admonition(*box) + [""])
@@ -241,8 +182,7 @@ def _quote_admonitions(paragraphs):
             box = (box[0], box[1] + [""] + paragraph)
         else:
             out.extend(["> " + line if line else ">" for line in paragraph] + [""])
-    out.extend(_admonition(*box))
-    return out
+    return out + _admonition(*box)
 
 
 def _admonition(lead, paragraph):
@@ -254,7 +194,7 @@ def _admonition(lead, paragraph):
 
 def chapter_entry(nb, page: str) -> dict:
     """Number, title and numbered sections of chapter notebook `nb`, for the landing page."""
-    text = "\n\n".join(_source(cell) for cell in nb.cells if cell.get("cell_type") == "markdown")
+    text = "\n\n".join(text_of(cell.source) for cell in nb.cells if cell.get("cell_type") == "markdown")
     title = _CHAPTER_TITLE.search(text)
     if title is None:
         raise ValueError(f"notebook {page!r} has no '# ' title line in its markdown cells")
@@ -263,19 +203,13 @@ def chapter_entry(nb, page: str) -> dict:
     return {"number": number, "title": title.group(2), "page": page, "sections": sections}
 
 
-def _source(cell) -> str:
-    source = cell.get("source", "")
-    return "".join(source) if isinstance(source, list) else source
-
-
-def landing_page(chapters: list[dict], *, student: bool = False, run_online: str = "") -> str:
+def landing_page(chapters: list[dict], *, student: bool = False) -> str:
     """The MyST text of the landing page: the chapter table and how to run the notebooks."""
     edition = ("This is the **student edition**: the exercises are there, their solutions are not."
                if student else
                "Each exercise is followed by its worked solution, folded: click the line above it to open it.")
     rows = [f"| {c['number']} | [{c['title']}]({c['page']}.ipynb) | {' · '.join(c['sections'])} |"
             for c in chapters]
-    online = f"\n### Run online\n\n{run_online.strip()}\n" if run_online.strip() else ""
     toctree = "\n".join(c["page"] for c in chapters)
     return f"""# State-space control: the course notebooks
 
@@ -306,7 +240,7 @@ python -m jupyterlab notebooks/
 JupyterLab opens in the browser; open a chapter and use *Run > Run All Cells*. As root (a
 container, a cloud machine) add `--allow-root` to the second command. The repository's
 `environment.md` shows how to make the environment with venv, conda or uv.
-{online}
+
 ```{{toctree}}
 :hidden:
 :maxdepth: 2
@@ -316,8 +250,17 @@ container, a cloud machine) add `--allow-root` to the second command. The reposi
 """
 
 
-def sphinx_conf(*, title: str) -> str:
-    """The Sphinx ``conf.py`` of the site: MyST-NB without execution, the book theme, MathJax offline."""
+def sphinx_conf(*, title: str, repository: str | None = None) -> str:
+    """The Sphinx ``conf.py`` of the site: MyST-NB without execution, the book theme, MathJax
+    offline; with the course repository's address on GitHub (`github_repository`), the theme's
+    button to the repository and on each chapter its launch buttons (Binder, Colab), none before."""
+    github = github_repository(repository)
+    online = "" if github is None else f"""
+    "repository_url": {github!r},
+    "repository_branch": "main",
+    "path_to_docs": "notebooks",
+    "launch_buttons": {{"binderhub_url": "https://mybinder.org", "colab_url": "https://colab.research.google.com",
+                       "notebook_interface": "jupyterlab"}},"""
     return f"""# generated by coursekit.tools.site; the site is rebuilt from the notebooks each time
 project = {title!r}
 author = "coursekit"
@@ -332,6 +275,8 @@ myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence"]
 myst_dmath_double_inline = True
 myst_heading_anchors = 3
 suppress_warnings = ["myst.header", "mystnb.unknown_mime_type"]
+# a widget's view is an empty area without a kernel: an explorer shows its figure, other widgets their text
+nb_mime_priority_overrides = [("*", {WIDGET_VIEW!r}, None)]
 html_theme = "sphinx_book_theme"
 html_title = {title!r}
 html_static_path = ["_static"]
@@ -342,7 +287,7 @@ html_theme_options = {{
     "show_toc_level": 2,
     "use_download_button": False,
     "use_fullscreen_button": False,
-    "use_repository_button": False,
+    "use_repository_button": {github is not None},{online}
     "use_source_button": False,
     "use_issues_button": False,
     "use_edit_page_button": False,
@@ -354,38 +299,95 @@ html_copy_source = False
 """
 
 
-def build_site(out_dir, *, student: bool = False, notebooks_dir=None, timeout: int = 600,
-               verbose: bool = False) -> Path:
+def build_site(out_dir, *, student: bool = False, student_out=None, notebooks_dir=None,
+               timeout: int = 600, verbose: bool = False) -> Path:
     """Build the course website into `out_dir` and return the path of its ``index.html``.
 
-    `student=True` builds it from the student edition (no solutions). `notebooks_dir` defaults to
-    the repository's ``notebooks/``; `timeout` is the limit in seconds for one notebook cell;
-    the landing page links to Binder, Colab and the repository once the notebooks' install cell
-    holds the repository's address (``python -m coursekit colab``); `verbose=True` prints each
-    step to stderr. `out_dir` is replaced by the new site.
+    `student=True` builds it from the student edition (no solutions); `student_out`, a second
+    folder, also builds the student edition there from the same execution of the notebooks.
+    `notebooks_dir` defaults to the repository's ``notebooks/``; `timeout` is the limit in
+    seconds for one notebook cell; the pages get buttons to the repository, Binder and Colab
+    once the notebooks' install cell holds its address on GitHub (``python -m coursekit
+    colab``); `verbose=True` prints each step to stderr. Each output folder is replaced by its
+    new site.
     """
     if not isinstance(student, bool):
         raise TypeError(f"student must be True or False, got {student!r}")
-    out, sources = start_build(out_dir, notebooks_dir, timeout=timeout, verbose=verbose,
-                               built_before=_built_before, kind="a site")
+    if student and student_out is not None:
+        raise ValueError("student_out builds the student edition beside the full one in out_dir: "
+                         "pass student=False (no --student) with it")
+    editions = {}
+    for folder, is_student in [(out_dir, student)] + ([(student_out, True)] if student_out is not None else []):
+        out, sources = start_build(folder, notebooks_dir, timeout=timeout, verbose=verbose,
+                                   built_before=_built_before, kind="a site")
+        if out in editions:
+            raise ValueError(f"student_out {str(student_out)!r} is out_dir: pick another folder for the student edition")
+        editions[out] = is_student
     missing = missing_site_tools()
     if missing:
         raise RuntimeError("the site tools are not installed (" + ", ".join(missing) + "): run "
                            "python -m pip install -e \".[site]\" from the repository root")
     with tempfile.TemporaryDirectory(prefix="coursekit-site-") as tmp:
-        src = Path(tmp) / "src"
-        src.mkdir()
-        chapters = _prepare_all(sources, src, student=student, timeout=timeout, verbose=verbose)
-        import nbformat
-        _write_sources(src, chapters, student=student,
-                       repository=repository_of(nbformat.read(sources[0], as_version=4)))
-        html = Path(tmp) / "html"
-        _say(verbose, "building the HTML pages with Sphinx")
-        _run_sphinx(src, html)
-        if out.exists():
-            shutil.rmtree(out)
-        shutil.copytree(html, out)
-    return out / "index.html"
+        read = [read_notebook(path) for path in sources]
+        executed = _executed(read, sources, editions=set(editions.values()), timeout=timeout, verbose=verbose)
+        for n, (out, is_student) in enumerate(editions.items()):
+            src = Path(tmp) / f"src{n}"
+            chapters = [_page(nb, ran, path, src, student=is_student)
+                        for nb, ran, path in zip(read, executed, sources)]
+            _write_sources(src, chapters, student=is_student, repository=repository_of(read[0]))
+            say(verbose, "the site", "building the HTML pages with Sphinx")
+            _run_sphinx(src, Path(tmp) / f"html{n}")
+            if out.exists():
+                shutil.rmtree(out)
+            shutil.copytree(Path(tmp) / f"html{n}", out)
+    return next(iter(editions)) / "index.html"
+
+
+def _shares_execution(nb) -> bool:
+    """Whether the student edition of `nb` runs the same code as `nb`: no solution is code."""
+    return not any(c.cell_type == "code" and is_solution(c) for c in nb.cells)
+
+
+def _executed(notebooks: list, sources: list[Path], *, editions: set, timeout: int, verbose: bool) -> list:
+    """Per notebook ``{student: (page, sizes)}``: its page executed for the editions of `editions`
+    (True: the student edition), once for both unless a solution is code; each figure with its
+    description as ``alt``, and the size of the smallest text of each image (`figure_text_sizes`)."""
+    jobs = []
+    for k, (nb, path) in enumerate(zip(notebooks, sources)):
+        for student in sorted({False} if _shares_execution(nb) else editions):  # False serves both
+            jobs.append((k, student, for_the_site(student_text(nb) if student else copy.deepcopy(nb), path.name)))
+    execute_all([page for *_, page in jobs], [sources[k] for k, *_ in jobs], prelude=SITE_FIGURES,
+                timeout=timeout, what="the site", verbose=verbose)
+    executed = [{} for _ in notebooks]
+    for k, student, page in jobs:
+        harvest_alt_texts(page)
+        page.metadata.pop("widgets", None)    # the state MyST-NB would load ipywidgets' script for
+        for cell in page.cells:               # MyST-NB takes an image's alt from its cell
+            alts = [o.metadata["image/png"]["alt"] for o in cell.get("outputs", [])
+                    if "alt" in o.get("metadata", {}).get("image/png", {})]
+            if alts:
+                cell.metadata.setdefault("mystnb", {}).setdefault("image", {})["alt"] = " ".join(alts)
+        executed[k][student] = (page, figure_text_sizes(page))
+    return executed
+
+
+def _page(nb, executed: dict, path: Path, src: Path, *, student: bool) -> dict:
+    """Write chapter `nb` (read from `path`) into `src` as its page shows it in the edition asked
+    for, from `executed` (see `_executed`), with the notebook to download; its landing entry."""
+    (src / "downloads").mkdir(parents=True, exist_ok=True)
+    write_notebook(student_edition(nb) if student else nb, src / "downloads" / path.name)
+    page, sizes = copy.deepcopy(executed.get(student, executed.get(False)))
+    if student:
+        page = student_text(page)       # no change where the student edition was executed
+    frames = static_explorers.publish(page, src / "_static" / static_explorers.ASSETS,
+                                      f"_static/{static_explorers.ASSETS}", stem=path.stem)
+    fold_solution_code(page)
+    for cell in page.cells:
+        if cell.cell_type == "markdown":
+            cell.source = erratum_admonitions(text_of(cell.source))
+    write_notebook(page, src / path.name)
+    sizes.update({f["sha256"]: f["smallest_text_pt"] for f in frames if f["smallest_text_pt"] is not None})
+    return {**chapter_entry(page, path.stem), "smallest_text_pt": sizes, "frames": frames}
 
 
 def _built_before(folder: Path) -> bool:
@@ -393,75 +395,25 @@ def _built_before(folder: Path) -> bool:
     return (folder / "index.html").is_file() and (folder / "_static").is_dir()
 
 
-def _say(verbose: bool, message: str) -> None:
-    if verbose:
-        print(f"coursekit site: {message}", file=sys.stderr, flush=True)
-
-
-def _prepare_all(sources: list[Path], src: Path, *, student: bool, timeout: int,
-                 verbose: bool) -> list[dict]:
-    """Prepare every notebook, one worker process (and kernel) per core, in chapter order."""
-    workers = max(1, min(len(sources), os.cpu_count() or 1))
-    _say(verbose, f"executing {len(sources)} notebooks, {workers} at a time")
-    context = multiprocessing.get_context("spawn")
-    with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
-        futures = [pool.submit(_prepare, path, src, student=student, timeout=timeout)
-                   for path in sources]
-        chapters = []
-        for path, future in zip(sources, futures):
-            chapters.append(future.result())
-            _say(verbose, f"executed {path.name}")
-    return chapters
-
-
-def _prepare(path: Path, src: Path, *, student: bool, timeout: int) -> dict:
-    """Read, edit, execute and write one chapter notebook into `src`; return its landing entry."""
-    import nbformat
-    nb = nbformat.read(path, as_version=4)
-    if student:
-        from .release import student_edition   # the one definition of the student edition
-        nb = student_edition(nb)
-    (src / "downloads").mkdir(exist_ok=True)
-    nbformat.write(nb, src / "downloads" / path.name)       # the notebook as a reader downloads it
-    nb = for_the_site(nb, path.name, repository=repository_of(nb))
-    nb.cells.insert(0, nbformat.v4.new_code_cell(SITE_FIGURES))
-    _execute(nb, cwd=path.parent, timeout=timeout, name=path.name)
-    nb.cells.pop(0)
-    describe_images(nb)
-    sizes = figure_text_sizes(nb)
-    strip_widget_views(nb)
-    frames = static_explorers.publish(nb, src / "_static" / static_explorers.ASSETS,
-                                      f"_static/{static_explorers.ASSETS}", stem=path.stem)
-    fold_solution_code(nb)
-    for cell in nb.cells:
-        if cell.cell_type == "markdown":
-            cell.source = erratum_admonitions(_source(cell))
-    nbformat.write(nb, src / path.name)
-    sizes.update({f["sha256"]: f["smallest_text_pt"] for f in frames if f["smallest_text_pt"] is not None})
-    return {**chapter_entry(nb, path.stem), "smallest_text_pt": sizes, "frames": frames}
-
-
 def repository_of(nb) -> str | None:
     """The course repository's https address, as the install cell of `nb` holds it (None until
     ``python -m coursekit colab`` has written one)."""
     from .colab import cell_repository
-    return next((cell_repository(_source(c)) for c in nb.cells if role(c) == INSTALL), None)
+    return next((cell_repository(text_of(c.source)) for c in nb.cells if role(c) == INSTALL), None)
 
 
-def for_the_site(nb, name: str, *, repository: str | None = None):
+def for_the_site(nb, name: str):
     """`nb` as its page shows it: without the setup cells (the install cell and the environment
-    check, whose output is the build machine's), with a line to download the notebook under its
-    title (and to the repository, when its address is known)."""
+    check, whose output is the build machine's), with a line under its title to download the
+    notebook as it is handed out (the theme's download button would give the page's source: the
+    notebook executed and rewritten for the site)."""
     import nbformat
     nb.cells = [c for c in nb.cells if role(c) not in (INSTALL, ENVIRONMENT)]
-    where = f" · [the course repository]({repository})" if repository else ""
     nb.cells.insert(1, nbformat.v4.new_markdown_cell(
-        f"Download this chapter as a notebook: {{download}}`{name} <downloads/{name}>`{where}"))
+        f"Download this chapter as a notebook: {{download}}`{name} <downloads/{name}>`"))
     return nb
 
 
-#: the media type under which the kernel adds each figure's description to its display data
-ALT = "text/x-coursekit-alt"
 #: the media type under which it adds the size of each figure's smallest text, in points
 SMALLEST_TEXT = "text/x-coursekit-smallest-text-pt"
 #: the file of the site, under ``_static``, that gives the size in points of the smallest text of
@@ -477,23 +429,6 @@ _site_figures.install(get_ipython())
 """
 
 
-def describe_images(nb):
-    """Give each code cell's images of `nb` their descriptions as ``alt`` (in place; returned):
-    a figure's from `ALT`, an explorer's from its text (title, settings, readout and data)."""
-    for cell in nb.cells:
-        texts = []
-        for output in cell.get("outputs", []):
-            data = output.get("data", {})
-            if ALT in data:
-                texts.append(_source({"source": data.pop(ALT)}))
-            elif "image/png" in data and WIDGET_VIEW in data:
-                texts.append(_source({"source": data.get("text/plain", "")}))
-        if texts:
-            mystnb = cell.metadata.setdefault("mystnb", {})
-            mystnb["image"] = {**mystnb.get("image", {}), "alt": " ".join(texts)}
-    return nb
-
-
 def figure_text_sizes(nb) -> dict[str, float]:
     """Remove the `SMALLEST_TEXT` data from the outputs of `nb` (in place) and return them as
     {SHA-256 of the output's PNG: size in points of the smallest text of that image}."""
@@ -503,29 +438,17 @@ def figure_text_sizes(nb) -> dict[str, float]:
     for cell in nb.cells:
         for output in cell.get("outputs", []):
             data = output.get("data", {})
-            size = _source({"source": data.pop(SMALLEST_TEXT, "None")})
+            size = text_of(data.pop(SMALLEST_TEXT, "None"))
             if size != "None" and "image/png" in data:
-                png = base64.b64decode(_source({"source": data["image/png"]}))
+                png = base64.b64decode(text_of(data["image/png"]))
                 sizes[hashlib.sha256(png).hexdigest()] = float(size)
     return sizes
 
 
-def _execute(nb, *, cwd: Path, timeout: int, name: str) -> None:
-    from nbclient import NotebookClient
-    from nbclient.exceptions import CellExecutionError
-    client = NotebookClient(nb, timeout=timeout, kernel_name="python3", store_widget_state=False,
-                            resources={"metadata": {"path": str(cwd)}})
-    try:
-        client.execute()
-    except CellExecutionError as error:
-        raise RuntimeError(f"notebook {name} failed while building the site:\n{error}") from None
-
-
 def _write_sources(src: Path, chapters: list[dict], *, student: bool, repository: str | None) -> None:
     title = "Course notebooks (student edition)" if student else "Course notebooks"
-    (src / "index.md").write_text(landing_page(chapters, student=student, run_online=run_online(repository)),
-                                  encoding="utf-8")
-    (src / "conf.py").write_text(sphinx_conf(title=title), encoding="utf-8")
+    (src / "index.md").write_text(landing_page(chapters, student=student), encoding="utf-8")
+    (src / "conf.py").write_text(sphinx_conf(title=title, repository=repository), encoding="utf-8")
     (src / "_static").mkdir(exist_ok=True)      # the explorers' frames may be there already
     static_explorers.copy_assets(src / "_static" / static_explorers.ASSETS)
     frames = [f for chapter in chapters for f in chapter.get("frames", [])]
@@ -538,17 +461,12 @@ def _write_sources(src: Path, chapters: list[dict], *, student: bool, repository
                                                  encoding="utf-8")
 
 
-def run_online(repository: str | None) -> str:
-    """The landing page's "Run online" text for the course repository at `repository` (an https
-    address on GitHub), or '' when there is none: no link is published before it can work."""
+def github_repository(repository: str | None) -> str | None:
+    """`repository` as the book theme's buttons take it when it is an https address on GitHub
+    (``https://github.com/OWNER/NAME``, no ``.git``), else None: no link is published before it
+    can work (Binder and Colab open GitHub repositories)."""
     match = re.fullmatch(r"https://github\.com/([\w.-]+/[\w.-]+?)(?:\.git)?/?", repository or "")
-    if match is None:
-        return ""
-    path = match.group(1)
-    return (f"Open a chapter on [Binder](https://mybinder.org/v2/gh/{path}/HEAD?urlpath=lab/tree/notebooks) "
-            f"(a temporary JupyterLab; nothing is saved) or on Google Colab "
-            f"(https://colab.research.google.com/github/{path}/blob/main/notebooks/, then the chapter's file "
-            f"name), or get everything from [the course repository]({repository}).")
+    return f"https://github.com/{match.group(1)}" if match else None
 
 
 def _run_sphinx(src: Path, html: Path) -> None:

@@ -23,7 +23,8 @@ import contextlib
 
 from IPython.core.formatters import BaseFormatter, PNGFormatter
 
-from .site import ALT, SMALLEST_TEXT
+from .notebooks import ALT
+from .site import SMALLEST_TEXT
 
 __all__ = ["COLUMN_PX", "MIN_TEXT_PX", "smallest_text_pt", "column_zoom",
            "drawn_for_the_column", "explorer_png", "FigureOutput", "ColumnPNGFormatter", "add_output",

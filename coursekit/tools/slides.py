@@ -23,7 +23,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from .release import notebook_paths, read_notebook, write_notebook
+from .notebooks import update_notebooks
 
 __all__ = ["slide_type", "slide_types", "with_slide_metadata", "apply_slide_metadata"]
 
@@ -89,16 +89,11 @@ def apply_slide_metadata(notebooks: Path | str | None = None, *, write: bool = T
     if notebooks is not None and not isinstance(notebooks, (str, Path)):
         raise TypeError(f"notebooks must be a folder path (str or Path) or None: received "
                         f"{type(notebooks).__name__}.")
-    if not isinstance(write, bool):
-        raise TypeError(f"write must be True or False: received {write!r}.")
-    _, paths = notebook_paths(notebooks)
-    changed = []
-    for path in paths:
-        nb = read_notebook(path)
-        stored = [_stored_type(cell) for cell in nb.cells]
-        explicit_dash = any(cell.metadata.get("slideshow", {}).get("slide_type") == "-" for cell in nb.cells)
-        if stored != slide_types(nb) or explicit_dash:
-            changed.append(path)
-            if write:
-                write_notebook(with_slide_metadata(nb), path)
-    return changed
+    return update_notebooks(notebooks, _stale, with_slide_metadata, write=write)
+
+
+def _stale(nb) -> bool:
+    """Whether a cell of `nb` lacks its slide type, or stores the default "-" explicitly."""
+    stored = [_stored_type(cell) for cell in nb.cells]
+    explicit_dash = any(cell.metadata.get("slideshow", {}).get("slide_type") == "-" for cell in nb.cells)
+    return stored != slide_types(nb) or explicit_dash

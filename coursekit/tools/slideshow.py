@@ -1,12 +1,12 @@
 """The course's slides: ``python -m coursekit slides --out DIR`` calls :func:`build_slides`.
 
-Every chapter notebook (found by `coursekit.tools.chapters`) becomes one reveal.js slide show,
+Every chapter notebook (found by `coursekit.tools.notebooks`) becomes one reveal.js slide show,
 executed, in one folder with an index page that links them. The build needs no network and
 neither do the slides:
 
 1. each notebook gets the slide types of `coursekit.tools.slides` (in memory: the notebooks
-   are not rewritten) and is executed with nbclient, the kernels side by side, without storing
-   widget state; each figure gets its text alternative from its data, as on the website
+   are not rewritten) and is executed (`coursekit.tools.notebooks.execute_all`); each figure gets
+   its text alternative from its data (`coursekit.tools.notebooks.harvest_alt_texts`), as on the website
    (`DESCRIBE_FIGURES`, with the website's `coursekit.tools.site_figures.add_output`), and each
    explorer its frames for the settings its sliders stop at: on the slides its sliders are native
    range inputs that swap the frames, with no kernel (`coursekit.tools.static_explorers`);
@@ -27,22 +27,20 @@ The tools are the optional ``slides`` extra (``pip install -e ".[slides]"``).
 
 from __future__ import annotations
 
-import asyncio
 import html
 import importlib.util
-import os
 import shutil
-import sys
 import tempfile
 from pathlib import Path
 
 from . import static_explorers
 from .builds import start_build
-from .site import ALT, WIDGET_VIEW, chapter_entry
+from .notebooks import ALT, execute_all, harvest_alt_texts, read_notebook, say
+from .site import chapter_entry
 from .slides import with_slide_metadata
 
-__all__ = ["SLIDE_TOOLS", "DESCRIBE_FIGURES", "TEMPLATE", "MATHJAX", "SUFFIX", "build_slides", "missing_slide_tools", "asset_folders",
-           "figure_alt_texts", "slides_exporter", "index_page"]
+__all__ = ["SLIDE_TOOLS", "DESCRIBE_FIGURES", "TEMPLATE", "MATHJAX", "SUFFIX", "build_slides", "missing_slide_tools",
+           "asset_folders", "slides_exporter", "index_page"]
 
 #: import name -> pip name of what the build needs (the ``slides`` extra)
 SLIDE_TOOLS = {"nbconvert": "nbconvert", "nbclient": "nbclient", "nbformat": "nbformat",
@@ -92,25 +90,6 @@ def asset_folders() -> dict[str, Path]:
                                f"{inside}/{probe}; run {_INSTALL}")
         folders[name] = folder
     return folders
-
-
-def figure_alt_texts(nb):
-    """Give every figure of `nb` its text alternative (in place; returned).
-
-    The text goes into the output's ``metadata["image/png"]["alt"]``, which the template writes
-    into the image's ``alt``: a figure's from its described data (`ALT`, removed from the data),
-    an explorer's from its text (title, settings, readout and data).
-    """
-    for cell in nb.cells:
-        for output in cell.get("outputs", []):
-            data = output.get("data", {})
-            text = data.pop(ALT, None)
-            if text is None and "image/png" in data and WIDGET_VIEW in data:
-                text = data.get("text/plain")
-            if text and "image/png" in data:
-                alt = "".join(text) if isinstance(text, list) else text
-                output.setdefault("metadata", {}).setdefault("image/png", {})["alt"] = alt.strip()
-    return nb
 
 
 def slides_exporter():
@@ -172,11 +151,14 @@ def build_slides(out_dir, *, notebooks_dir=None, timeout: int = 600, verbose: bo
     if missing:
         raise RuntimeError(f"the slide tools are not installed ({', '.join(missing)}): run {_INSTALL}")
     assets = asset_folders()
-    notebooks = _executed(sources, timeout=timeout, verbose=verbose)
+    notebooks = [with_slide_metadata(read_notebook(path)) for path in sources]
+    execute_all(notebooks, sources, prelude=DESCRIBE_FIGURES, timeout=timeout, what="the slides", verbose=verbose)
+    for nb in notebooks:
+        harvest_alt_texts(nb)
     with tempfile.TemporaryDirectory(prefix="coursekit-slides-") as tmp:
         folder = Path(tmp) / "slides"
         folder.mkdir()
-        _say(verbose, "writing the slides")
+        say(verbose, "the slides", "writing the slides")
         frames = []
         chapters = [_write_chapter(nb, path, folder, frames) for nb, path in zip(notebooks, sources)]
         static_explorers.check_site_budget(frames, what="the slides")
@@ -193,46 +175,6 @@ def build_slides(out_dir, *, notebooks_dir=None, timeout: int = 600, verbose: bo
 def _built_before(folder: Path) -> bool:
     """Whether `folder` holds slides built before (which a new build may replace)."""
     return (folder / "index.html").is_file() and all((folder / name).is_dir() for name in _ASSETS)
-
-
-def _say(verbose: bool, message: str) -> None:
-    if verbose:
-        print(f"coursekit slides: {message}", file=sys.stderr, flush=True)
-
-
-def _executed(sources: list[Path], *, timeout: int, verbose: bool) -> list:
-    """Every notebook of `sources`, with its slide types, executed (one kernel per core at a time)."""
-    import nbformat
-    notebooks = []
-    for path in sources:
-        nb = with_slide_metadata(nbformat.read(path, as_version=4))
-        nb.cells.insert(0, nbformat.v4.new_code_cell(DESCRIBE_FIGURES))
-        notebooks.append(nb)
-    workers = max(1, min(len(sources), os.cpu_count() or 1))
-    _say(verbose, f"executing {len(sources)} notebooks, {workers} at a time")
-    asyncio.run(_execute_all(notebooks, sources, timeout=timeout, workers=workers, verbose=verbose))
-    for nb in notebooks:
-        nb.cells.pop(0)
-        figure_alt_texts(nb)
-    return notebooks
-
-
-async def _execute_all(notebooks, sources, *, timeout: int, workers: int, verbose: bool) -> None:
-    from nbclient import NotebookClient
-    from nbclient.exceptions import CellExecutionError
-    gate = asyncio.Semaphore(workers)
-
-    async def run(nb, path):
-        client = NotebookClient(nb, timeout=timeout, kernel_name="python3", store_widget_state=False,
-                                resources={"metadata": {"path": str(path.parent)}})
-        async with gate:
-            try:
-                await client.async_execute()
-            except CellExecutionError as error:
-                raise RuntimeError(f"notebook {path.name} failed while building the slides:\n{error}") from None
-        _say(verbose, f"executed {path.name}")
-
-    await asyncio.gather(*(run(nb, path) for nb, path in zip(notebooks, sources)))
 
 
 def _write_chapter(nb, path: Path, folder: Path, frames: list) -> dict:

@@ -49,6 +49,7 @@ from pathlib import Path
 from ...exercises._answers import ANSWERS_ENV, decode, read_last_records
 from ...exercises._catalog import CATALOG, chapter_exercises
 from ...exercises._feedback import feedback_to
+from ..notebooks import write_notebook
 from .kernel import kernel_argv
 from .runner import RUNNER_STATUSES
 from .sandbox import Sandbox, SandboxUnavailable, check_sandbox
@@ -185,6 +186,7 @@ class _Run:
     """The settings of one grading run that every notebook shares."""
 
     chapter: int
+    exercises: tuple            # the chapter's exercises, fetched once for the whole run
     timeout: float
     memory: int
     folder: Path                    # the run's temporary folder: one sub-folder per submission
@@ -201,13 +203,12 @@ class _Run:
 
 def _run_notebook(nb, number: int, run: _Run, checks: list[str]) -> tuple[str, str, list[dict], dict[str, dict]]:
     """Execute `nb` in a sandbox of its own; (status, detail, cell errors, last answer to each of `checks`)."""
-    import nbformat
     own = run.folder / str(number)
     box, private = own / "box", own / "runner"       # the kernel's only writable folder; the runner's
     box.mkdir(parents=True)
     private.mkdir()
     notebook = private / "submission.ipynb"
-    nbformat.write(nb, notebook)
+    write_notebook(nb, notebook)
     answers, work = box / "answers.jsonl", box / "submission"
     answers.touch()
     work.mkdir()
@@ -316,7 +317,7 @@ def _error_lines(nb, errors: list[dict], exercises) -> list[str]:
 
 
 def _grade_one(path: Path, number: int, run: _Run) -> Outcome:
-    student, exercises = student_id(path), chapter_exercises(run.chapter)
+    student, exercises = student_id(path), run.exercises
     try:
         read = _read_submission(path, run.chapter)
         if isinstance(read, tuple):
@@ -391,8 +392,9 @@ def _require_tools() -> None:
                            "python -m pip install \"coursekit[grade]\" (or -e \".[grade]\" in the repository)")
 
 
-def _check_arguments(submissions: Path, out: Path, chapter, timeout, jobs) -> None:
-    chapter_exercises(chapter)
+def _check_arguments(submissions: Path, out: Path, chapter, timeout, jobs) -> tuple:
+    """The exercises of `chapter`, once every argument is checked."""
+    exercises = tuple(chapter_exercises(chapter))
     if not submissions.is_dir():
         raise ValueError(f"submissions: {submissions} is not a folder; pass the folder of submitted notebooks")
     if out.resolve() == submissions.resolve():
@@ -401,6 +403,7 @@ def _check_arguments(submissions: Path, out: Path, chapter, timeout, jobs) -> No
         raise ValueError(f"timeout must be a positive number of seconds, received {timeout!r}")
     if not (isinstance(jobs, int) and jobs >= 1):
         raise ValueError(f"jobs must be a whole number of at least 1, received {jobs!r}")
+    return exercises
 
 
 def _sealed(run: _Run) -> None:
@@ -428,18 +431,18 @@ def grade(submissions, out, *, chapter: int, timeout: float = 300, memory: int |
     """
     submissions, out = Path(submissions), Path(out)
     jobs = (os.cpu_count() or 1) if jobs is None else jobs
-    _check_arguments(submissions, out, chapter, timeout, jobs)
+    exercises = _check_arguments(submissions, out, chapter, timeout, jobs)
     _require_tools()
     memory = parse_memory(memory) if isinstance(memory, str) else int(memory)
     paths = _submission_paths(submissions)
     # a notebook may leave files it made unremovable: that must not cost it its grades
     with tempfile.TemporaryDirectory(prefix="coursekit-grade-", ignore_cleanup_errors=True) as folder:
         hidden = tuple(Path(p).resolve() for p in (submissions, out, folder, Path.cwd()))
-        run = _Run(chapter, float(timeout), memory, Path(folder), hidden, bool(sandbox))
+        run = _Run(chapter, exercises, float(timeout), memory, Path(folder), hidden, bool(sandbox))
         if run.sandboxed:
             _sealed(run)
         with warnings.catch_warnings(), ThreadPoolExecutor(max_workers=jobs) as pool:
             warnings.simplefilter("ignore")      # the checks' warnings say nothing their feedback does not
             outcomes = list(pool.map(lambda item: _grade_one(item[1], item[0], run), enumerate(paths)))
     out.mkdir(parents=True, exist_ok=True)
-    return _write(outcomes, chapter_exercises(chapter), out)
+    return _write(outcomes, exercises, out)

@@ -34,6 +34,7 @@ import threading
 import time
 from pathlib import Path
 
+from ..notebooks import read_notebook
 from .kernel import set_limits
 
 __all__ = ["KERNEL_NAME", "RUNNER_MEMORY", "STARTS", "RUNNER_STATUSES", "write_kernel_spec", "execute",
@@ -137,12 +138,11 @@ def _started(nb, job: dict, kernels_dir: Path, deadline: float):
 
 
 def execute(job: dict, kernels_dir: Path) -> dict:
-    """Run the job's notebook (read with nbformat) and return its outcome (see the module docstring)."""
-    import nbformat
+    """Run the job's notebook and return its outcome (see the module docstring)."""
     from nbclient.exceptions import CellTimeoutError, DeadKernelError
 
     timeout = float(job["timeout"])
-    nb = nbformat.read(job["notebook"], as_version=4)
+    nb = read_notebook(job["notebook"])
     _clear_outputs(nb)
     deadline = time.monotonic() + timeout
     try:
