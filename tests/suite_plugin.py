@@ -24,6 +24,7 @@ NOTEBOOK_TESTS = {
     "test_figure_style.py::test_every_figure_a_notebook_shows_is_readable_by_everyone",
     "test_site.py::test_the_site_builds_with_every_outside_connection_refused",
     "test_slides.py::test_small_build_from_the_command_line_needs_no_network",
+    "test_tools_notebooks.py::test_execute_all_shuts_down_every_kernel_it_started",
 }
 #: fixtures that execute notebooks (or hand out executed ones): every test using one is marked
 NOTEBOOK_FIXTURES = {"executed_chapters", "release", "graded", "extended", "built", "small_site"}

@@ -153,7 +153,7 @@ def test_run_all_in_a_kernel_leaves_no_out_line_and_answers_nothing():
         sources += [_imports(cells)] + [c.source for c in cells if c.kind == "code" and c.exercise]
     sources.append("ex.check_stability([True, False, False, True])")   # a right answer, on the last line
     nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in sources])
-    NotebookClient(nb, km=this_python_kernel(), timeout=120).execute()
+    NotebookClient(nb, km=this_python_kernel(), timeout=120).execute(cleanup_kc=True)   # and shut it down
     outputs = [(cell.source, out) for cell in nb.cells for out in cell.outputs]
     shows_progress = [s for s in sources if s.startswith("ex.progress(")]   # the last cell of each notebook
     assert len(shows_progress) == len(NOTEBOOKS)

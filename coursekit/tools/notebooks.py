@@ -144,7 +144,7 @@ async def _execute_all(notebooks, paths, *, timeout, what, workers, verbose, ker
                                 resources={"metadata": {"path": str(Path(path).parent)}}, **manager)
         async with gate:
             try:
-                await client.async_execute()
+                await client.async_execute(cleanup_kc=True)   # shut down a kernel `kernel()` made too
             except CellExecutionError as error:
                 raise RuntimeError(f"notebook {Path(path).name} failed while building {what}:\n{error}") from None
         say(verbose, what, f"executed {Path(path).name}")
