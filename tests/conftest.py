@@ -27,3 +27,10 @@ def executed_chapters(tmp_path_factory):
     """The chapters executed once per session for the tests that read them (tests/executed_chapters.py)."""
     from executed_chapters import ExecutedChapters
     return ExecutedChapters(tmp_path_factory)
+
+
+@pytest.fixture(scope="session")
+def course_builds(tmp_path_factory, executed_chapters):
+    """The website and the slides built once per session for the tests that read them (tests/course_builds.py)."""
+    from course_builds import CourseBuilds
+    return CourseBuilds(tmp_path_factory, executed_chapters)

@@ -27,7 +27,7 @@ NOTEBOOK_TESTS = {
     "test_tools_notebooks.py::test_execute_all_shuts_down_every_kernel_it_started",
 }
 #: fixtures that execute notebooks (or hand out executed ones): every test using one is marked
-NOTEBOOK_FIXTURES = {"executed_chapters", "release", "graded", "extended", "built", "small_site"}
+NOTEBOOK_FIXTURES = {"executed_chapters", "course_builds", "release", "graded", "extended", "built", "small_site"}
 
 #: the modules whose tests parametrized over the course's explorers are sweeps
 SWEEP_MODULES = {"test_explorer_frames.py", "test_figure_layout.py", "test_figure_style.py"}

@@ -22,12 +22,11 @@ import nbformat
 import pytest
 
 from coursekit.__main__ import main
-from coursekit.tools.notebooks import chapter_notebooks, default_notebook_dir, read_notebook
+from coursekit.tools.notebooks import default_notebook_dir, read_notebook
 from coursekit.tools.site import missing_site_tools
 from coursekit.tools.slideshow import missing_slide_tools
 
 from build_structure import PARTS, record
-from executed_chapters import replaying
 from grading_cases import SANDBOX, solved
 
 RECORD = Path(__file__).with_name("build_structure.json")
@@ -45,9 +44,9 @@ def _submissions(folder: Path, release: Path) -> Path:
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory, executed_chapters) -> dict:
-    """The record of the four commands' outputs, built now; the slides take the chapters the
-    session executes for every test (tests/executed_chapters.py)."""
+def built(tmp_path_factory, course_builds) -> dict:
+    """The record of the four commands' outputs: the release and the grades built now, the site
+    and the slides the session's (tests/course_builds.py)."""
     missing = missing_site_tools() + missing_slide_tools()
     if missing:
         pytest.skip("the site and slides extras are not installed (missing: " + ", ".join(missing) + ")")
@@ -57,10 +56,9 @@ def built(tmp_path_factory, executed_chapters) -> dict:
     subs = _submissions(root / "submissions", folders["release"])
     assert main(["grade", str(subs), "--chapter", "1", "--out", str(folders["grade"]), "--jobs", "1",
                  *([] if SANDBOX else ["--no-sandbox"])]) == 0
-    assert main(["site", "--out", str(folders["site"]), "--student-out", str(folders["student_site"])]) == 0
-    executed_chapters.instructor([path.name for path in chapter_notebooks(default_notebook_dir())])
-    with replaying(executed_chapters):
-        assert main(["slides", "--out", str(folders["slides"])]) == 0
+    site = course_builds.site()
+    folders["site"], folders["student_site"] = site["instructor"], site["student"]
+    folders["slides"] = course_builds.slides()
     return record(folders)
 
 

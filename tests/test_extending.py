@@ -70,12 +70,14 @@ def test_the_new_chapter_is_found_by_the_course_tools(extended):
 
 
 @pytest.mark.parametrize("args", [
-    ["notebooks/05_lag.ipynb", "tests/test_slides.py", "tests/test_notebooks_clean.py"],
+    ["notebooks/05_lag.ipynb", "tests/test_slides.py", "tests/test_notebooks_clean.py", "-m", "not browser"],
     ["tests/test_bad_input.py", "-k", "lag or every_public"],
     ["tests/test_explorer_frames.py", "tests/test_figure_layout.py", "-k", "lag_explorer"],
     ["tests/test_figure_style.py", "-k", "lag_explorer or 05_lag"],
 ], ids=["notebook and slides", "bad input", "explorer frames and layout", "colours and contrast"])
 def test_the_checks_every_chapter_must_pass_pass_for_the_new_chapter(extended, args):
+    """The checks the doc names, on chapter 5 (the slides without the browser: CI's extended run
+    runs the README's whole test command, browser tests included, on such a copy)."""
     result = run_in([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *args], extended, timeout=900)
     assert result.returncode == 0, result.stdout[-5000:]
     assert re.search(r"\b\d+ passed", result.stdout), result.stdout[-2000:]

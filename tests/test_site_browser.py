@@ -60,19 +60,12 @@ def _skip_reason() -> str | None:
 
 
 @pytest.fixture(scope="module")
-def built(tmp_path_factory):
-    """Both editions, built once for the module: {edition: folder}."""
+def built(course_builds):
+    """Both editions, from the session's one build of the site (tests/course_builds.py): {edition: folder}."""
     reason = _skip_reason()
     if reason:
         pytest.skip(reason)
-    base = tmp_path_factory.mktemp("site")
-    folders = {}
-    for edition in EDITIONS:
-        start = time.monotonic()
-        site.build_site(base / edition, student=edition == "student")
-        print(f"\n{edition} site built in {time.monotonic() - start:.0f} s")
-        folders[edition] = base / edition
-    return folders
+    return course_builds.site()
 
 
 def _free_port() -> int:

@@ -17,7 +17,6 @@ import os
 import re
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import nbformat
@@ -30,7 +29,6 @@ from coursekit.tools.slides import apply_slide_metadata, slide_types, with_slide
 
 import lab_harness  # the browser tests' Chromium location, settings and axe-core
 import static_explorer_checks  # the explorers' sliders on a static page
-from executed_chapters import replaying
 
 NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))
 
@@ -276,21 +274,16 @@ def _expected_slides(path: Path) -> tuple[int, int]:
 
 
 @pytest.fixture(scope="module")
-def course(tmp_path_factory, executed_chapters):
-    """The slides of the whole course, built once with the command an instructor types; the
-    notebooks it executes take the outputs of the chapters this session executed already
-    (tests/executed_chapters.py: the same notebooks, run after the same first cell and the figure
-    checks'), which they must match cell by cell, and the others are executed as the command does."""
+def course(course_builds):
+    """The slides of the whole course, from the session's one build (tests/course_builds.py), with
+    the command an instructor types; the chapters this session executed already are replayed
+    there (tests/executed_chapters.py: the same notebooks, run after the same first cell and the
+    figure checks'), which they must match cell by cell, and the others are executed."""
     reason = lab_harness.missing_reason()
     if reason:
         pytest.skip(reason)
     _skip_without_slide_tools()
-    out = tmp_path_factory.mktemp("slides") / "slides"
-    start = time.monotonic()
-    with replaying(executed_chapters):
-        assert main(["slides", "--out", str(out)]) == 0
-    print(f"\nslides of {len(CHAPTERS)} chapters built in {time.monotonic() - start:.0f} s")
-    return out
+    return course_builds.slides()
 
 
 @pytest.fixture(scope="module")
