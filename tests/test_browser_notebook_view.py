@@ -3,6 +3,9 @@
 * ``ck.lecture_mode()`` run in a cell enlarges the notebook's own text: the computed font size
   of a markdown paragraph, a code cell, a text output and a widget label grows by half, and
   ``ck.lecture_mode(False)`` run in a later cell brings each back to its size before;
+* a notebook of explorers run, saved, closed and reopened with a new kernel (JupyterLab and
+  Notebook 7) shows each explorer's figure and text alternative, not a widget error; running
+  the cell again makes the explorer live (coursekit/explorers/_fallback.py);
 * each chapter notebook opened untouched stays unmodified once its kernel is connected (no
   unsaved mark on its tab) and closes without the "Save your work" dialog. JupyterLab writes
   the kernel's metadata into the notebook on connecting, so this holds when the notebooks store
@@ -16,7 +19,9 @@ Runs like tests/test_browser.py (marker ``browser``; skipped when Playwright or 
 from __future__ import annotations
 
 import json
+import re
 import shutil
+import time
 from pathlib import Path
 
 import nbformat
@@ -51,6 +56,11 @@ _RUN_CELL_JS = """i => { const panel = window.jupyterapp.shell.currentWidget;
     panel.content.activeCellIndex = i; return window.jupyterapp.commands.execute('notebook:run-cell'); }"""
 
 
+REOPENED = "reopened_explorers.ipynb"
+REOPENED_CELLS = ["%matplotlib inline\nfrom coursekit.explorers.ch1 import euler_explorer, msd_explorer",
+                  "euler_explorer()", "msd_explorer()"]
+
+
 @pytest.fixture(scope="module")
 def page(tmp_path_factory):
     """JupyterLab serving the lecture-mode notebook and untouched copies of the chapters."""
@@ -62,8 +72,10 @@ def page(tmp_path_factory):
     for path in chapter_notebooks(NOTEBOOKS):
         shutil.copy(path, base / "root" / UNTOUCHED / path.name)
     lab_h.write_notebook(base / "root" / LECTURE, LECTURE_CELLS)
+    lab_h.write_notebook(base / "root" / REOPENED, REOPENED_CELLS)
     with lab_h.running_lab(base / "root", base) as url, lab_h.launched_chromium() as browser:
         page = lab_h.new_lab_page(browser, url)
+        page.ck_url, page.ck_root = url, base / "root"
         yield page
         page.close()
         lab_h.shut_down_kernels(url)
@@ -159,3 +171,82 @@ def test_untouched_chapter_opens_unmodified_and_closes_without_asking(name, page
     assert not changed, f"{name}: JupyterLab changed the stored metadata {changed} on opening it"
     assert not state["dirty"] and not state["modelDirty"], f"{name}: marked modified though untouched"
     assert dialog is None, f"{name}: closing it untouched asked {dialog!r}"
+
+
+# every output the active notebook shows (not hidden): whether it is an explorer's fallback or a
+# live explorer, its figure's text alternative and whether the figure loaded, and its text
+_SHOWN_OUTPUTS_JS = """() => Array.from(document.querySelectorAll(
+        '.jp-NotebookPanel:not(.lm-mod-hidden) .jp-OutputArea-child'))
+    .filter(o => o.getClientRects().length > 0)
+    .map(o => { const img = o.querySelector('img');
+        return {fallback: !!o.querySelector('.ck-explorer-fallback'), live: !!o.querySelector('.ck-explorer'),
+                alt: img?.alt || '', loaded: !!img && img.complete && img.naturalWidth > 0,
+                text: o.innerText.trim().slice(0, 300)}; })"""
+
+
+def _shown_outputs(page, expected: int, kind: str, timeout: float = 60.0) -> list[dict]:
+    """The outputs shown once `expected` of them are of `kind` ('fallback' or 'live') with their
+    figure loaded (or after `timeout` seconds, whatever is shown then)."""
+    deadline = time.monotonic() + timeout
+    while True:
+        shown = page.evaluate(_SHOWN_OUTPUTS_JS)
+        if sum(o[kind] and o["loaded"] for o in shown) >= expected or time.monotonic() > deadline:
+            return shown
+        page.wait_for_timeout(500)
+
+
+def _reopened_shows_each_figure(page, shot: Path) -> None:
+    """Each explorer of the reopened notebook shows its saved figure with its text alternative,
+    and nothing shows a widget error; a screenshot of the notebook goes to `shot`."""
+    shown = _shown_outputs(page, 2, "fallback")
+    page.wait_for_timeout(3000)           # the widget manager has restored what it can by now
+    shown = page.evaluate(_SHOWN_OUTPUTS_JS)
+    page.screenshot(path=str(shot), full_page=True)
+    print(f"screenshot of the reopened notebook: {shot}")
+    assert [o["fallback"] for o in shown] == [True, True], shown
+    assert all(o["loaded"] and "Settings:" in o["alt"] and len(o["alt"]) > 40 for o in shown), shown
+    assert not any(re.search(r"Error displaying widget|Loading widget", o["text"]) for o in shown), shown
+
+
+def test_explorers_of_a_saved_notebook_show_their_figure_when_reopened_and_run_live_again(page, tmp_path):
+    """Run all, save, close, stop the kernel, reopen (JupyterLab, then Notebook 7): each explorer
+    shows its figure and text alternative, not "Error displaying widget: model not found";
+    running its cell again makes it live. Saving wrote outputs only, no widget state."""
+    lab_h.open_notebook(page, REOPENED)
+    lab_h.run_all(page)
+    lab_h.wait_until_done(page, 240)
+    live = _shown_outputs(page, 2, "live")
+    assert [(o["live"], o["fallback"]) for o in live] == [(True, False)] * 2, live    # no figure twice
+    lab_h.close_all(page)
+    lab_h.shut_down_kernels(page.ck_url)
+    saved = nbformat.read(page.ck_root / REOPENED, as_version=4)
+
+    lab_h.open_notebook(page, REOPENED)              # a new kernel: the widgets' models are gone
+    _reopened_shows_each_figure(page, tmp_path / "reopened-lab.png")
+    assert "widgets" not in saved.metadata
+    assert [len(cell.outputs) for cell in saved.cells] == [0, 2, 2]      # the fallback, the widget
+    assert not page.ck_page_errors, page.ck_page_errors
+    _run_cell(page, 0, ".jp-CodeCell")
+    _run_cell(page, 1, ".ck-explorer img")
+    shown = _shown_outputs(page, 1, "live")
+    assert [(o["live"], o["fallback"]) for o in shown] == [(True, False), (False, True)], shown
+    handle = page.locator(f"{lab_h.ACTIVE} .ck-explorer .noUi-handle").first
+    before = page.locator(f"{lab_h.ACTIVE} .ck-explorer img").first.get_attribute("src")
+    handle.focus()
+    handle.press("ArrowRight")
+    page.wait_for_function(f"src => document.querySelector('{lab_h.ACTIVE} .ck-explorer img').src !== src",
+                           arg=before, timeout=60_000)
+    page.screenshot(path=str(tmp_path / "run-again-lab.png"))
+    _close_active_tab(page)
+    lab_h.shut_down_kernels(page.ck_url)
+
+    pytest.importorskip("notebook", minversion="7", reason="Notebook 7 is not installed")
+    tab = page.context.browser.new_page(viewport=lab_h.VIEWPORT)
+    try:
+        tab.goto(f"{page.ck_url}/notebooks/{REOPENED}?token={lab_h.TOKEN}")
+        tab.wait_for_function("() => document.querySelector('.jp-Notebook-ExecutionIndicator')?.dataset.status"
+                              " === 'idle'", timeout=90_000)
+        _reopened_shows_each_figure(tab, tmp_path / "reopened-notebook7.png")
+    finally:
+        tab.close()
+        lab_h.shut_down_kernels(page.ck_url)

@@ -122,7 +122,10 @@ def executed_demo():
 
 
 def test_executed_notebook_output_carries_the_png_for_github_and_nbviewer(executed_demo):
-    data = executed_demo.cells[0].outputs[0]["data"]
+    fallback, shown = executed_demo.cells[0].outputs     # the figure for a reopened notebook first
+    assert fallback["metadata"] == {"coursekit_explorer_fallback": True}
+    assert 'class="ck-explorer-fallback"' in fallback["data"]["text/html"]
+    data = shown["data"]
     assert "application/vnd.jupyter.widget-view+json" in data
     assert base64.b64decode(data["image/png"]).startswith(PNG_MAGIC)
 

@@ -304,8 +304,8 @@ class Opened:
     to a page opened from the disk (failures and console errors of axe's own, not of the slides).
     """
 
-    def __init__(self, browser, url: str):
-        self.context = browser.new_context(viewport={"width": 1280, "height": 800})
+    def __init__(self, browser, url: str, viewport: dict | None = None):
+        self.context = browser.new_context(viewport=viewport or {"width": 1280, "height": 800})
         self.outside, self.failed, self.errors = [], [], []
         self.context.route("**/*", self._route)
         self.page = self.context.new_page()
@@ -337,8 +337,8 @@ class Opened:
 def opened(chromium):
     pages = []
 
-    def open_url(url):
-        pages.append(Opened(chromium, url))
+    def open_url(url, viewport=None):
+        pages.append(Opened(chromium, url, viewport))
         return pages[-1]
 
     yield open_url
@@ -366,9 +366,8 @@ MATH_REPORT = """() => {
 FIGURE_REPORT = """() => ({
   images: [...document.querySelectorAll('.reveal .slides img')].map(i => ({
     loaded: i.complete && i.naturalWidth > 0, alt: i.getAttribute('alt') || ''})),
-  explorers: [...document.querySelectorAll('.reveal .slides .jp-CodeCell')]
-    .filter(c => /\\b\\w+_explorer\\(/.test(c.querySelector('.jp-InputArea').textContent))
-    .map(c => c.querySelectorAll('.jp-OutputArea img').length),
+  explorers: [...document.querySelectorAll('.reveal .slides .ck-static-explorer')]
+    .map(e => e.querySelectorAll('img').length),
   widgets: document.querySelectorAll('.jupyter-widgets, script[type*="widget"]').length})"""
 
 
@@ -390,11 +389,16 @@ def test_chapter_slides_work_offline_with_each_equation_typeset_once(path, cours
     figures = view.page.evaluate(FIGURE_REPORT)
     assert figures["images"] and all(image["loaded"] for image in figures["images"])
     assert all(len(image["alt"]) > 40 and "No description" not in image["alt"] for image in figures["images"])
-    assert figures["explorers"] and all(count == 1 for count in figures["explorers"]), figures["explorers"]
+    explorers = sum(bool(re.search(r"\b\w+_explorer\(", c.source)) for c in read_notebook(path).cells
+                    if c.cell_type == "code")
+    assert len(figures["explorers"]) == explorers > 0, (figures["explorers"], explorers)
+    assert all(count == 1 for count in figures["explorers"]), figures["explorers"]
     assert figures["widgets"] == 0
-    # reveal.js: one slide per section, one more per sub-slide; the keys move through them
+    # reveal.js: one slide per section, one more per sub-slide (or more, a long one cut to fit the
+    # screen); the keys move through them
     sections, total = _expected_slides(path)
-    assert view.page.evaluate("[Reveal.getHorizontalSlides().length, Reveal.getTotalSlides()]") == [sections, total]
+    shown_sections, shown_total = view.page.evaluate("[Reveal.getHorizontalSlides().length, Reveal.getTotalSlides()]")
+    assert shown_sections == sections and shown_total >= total, (shown_sections, shown_total, sections, total)
     view.page.keyboard.press("ArrowRight")
     view.page.wait_for_function("Reveal.getIndices().h === 1")
     view.page.keyboard.press("Space")
@@ -456,4 +460,33 @@ def test_explorers_are_live_on_the_slides(path, course, opened):
     # the arrow keys pressed on the last explorer's sliders left its slide on screen
     assert view.page.evaluate("Reveal.getCurrentSlide().contains([...document.querySelectorAll("
                               "'.ck-static-explorer')].pop())")
+    view.assert_offline_and_clean()
+
+
+#: every slide shown in turn: how far its content runs past the slide (in the slide's pixels) and
+#: past the window (in the window's), and the smallest zoom of a block shown smaller to fit
+FIT_REPORT = """() => Reveal.getSlides().map(slide => {
+  const {h, v} = Reveal.getIndices(slide);
+  Reveal.slide(h, v);
+  const box = slide.getBoundingClientRect();
+  const zooms = [...slide.querySelectorAll('[style*="zoom"]')].map(e => parseFloat(e.style.zoom));
+  return {slide: `${h}/${v || 0}`, text: slide.textContent.trim().slice(0, 60),
+          past: slide.scrollHeight - slide.clientHeight,
+          off: Math.max(0, box.bottom - window.innerHeight, -box.top),
+          zoom: Math.min(1, ...zooms)};
+})"""
+
+
+@pytest.mark.browser
+@pytest.mark.parametrize("path", CHAPTERS, ids=lambda p: p.stem)
+def test_every_slide_fits_a_1280_by_720_screen(path, course, opened):
+    """Each slide shows all it holds on a 1280 x 720 screen, without scrolling: a sub-slide too
+    long for it is cut into several, and a block too tall by itself is shown a little smaller."""
+    view = opened((course / f"{path.stem}{slideshow.SUFFIX}").as_uri(), viewport={"width": 1280, "height": 720})
+    view.wait_for_reveal()
+    view.page.evaluate("Reveal.configure({transition: 'none'})")
+    slides = view.page.evaluate(FIT_REPORT)
+    too_tall = [s for s in slides if s["past"] > 1 or s["off"] > 1]
+    assert not too_tall, f"{len(too_tall)} of {len(slides)} slides do not fit: {too_tall}"
+    assert min(s["zoom"] for s in slides) >= 0.8, [s for s in slides if s["zoom"] < 0.8]
     view.assert_offline_and_clean()

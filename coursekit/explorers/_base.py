@@ -8,7 +8,7 @@ to the controls. A `FrameRenderer` draws each frame, blitting while the axes sta
 hand moves a control `rescale` only grows the limits; one frame fits them once it rests); a
 `FigureView` shows it at the size and pixel ratio the browser reports. Callbacks run on the
 kernel's main thread (`HomeThread`). The display data also carry a static PNG, for pages
-without a kernel (GitHub, the website).
+without a kernel (GitHub, the website), and a fallback output comes before them (`_fallback`).
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ import numpy as np
 
 from .._validation import as_scalar
 from ..describe import describe_figure
+from ._fallback import publish_fallback
 from ._frames import FrameRenderer
 
 __all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale"]
@@ -350,6 +351,7 @@ class Explorer:
         bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude)
         bundle["image/png"] = base64.b64encode(self.static_png()).decode("ascii")
         bundle["text/plain"] = repr(self)
+        publish_fallback(self)   # shown before the widget where it cannot be (a reopened notebook)
         return bundle
 
     def __repr__(self) -> str:   # the text a page without a kernel shows for the figure: its alt and data

@@ -18,7 +18,9 @@ neither do the slides:
    Fonts). MathJax typesets the slides, and only them, before reveal.js starts: reveal.js copies
    the text of the slide shown into a live region for screen readers, and that copy must be the
    typeset equations, not TeX for MathJax to typeset a second time. The slides are 1280 x 800
-   without the ``In [n]:`` prompts, so that a line of the notebooks' code fits;
+   without the ``In [n]:`` prompts, so that a line of the notebooks' code fits; a sub-slide
+   taller than that is cut into sub-slides that fit, in the page before reveal.js starts (the
+   template's script measures the typeset slides);
 3. reveal.js (from the PyPI package ``sphinx-revealjs``) and MathJax 3 (from
    ``sphinx-mathjax-offline``, which the website uses too) are copied into the folder.
 

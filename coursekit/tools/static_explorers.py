@@ -354,10 +354,13 @@ def explorer_html(data: dict, sources: list[str], *, ident: str) -> str:
 def publish(nb, folder: Path, url: str, *, stem: str) -> list[dict]:
     """Write the frames of every explorer of the executed notebook `nb` into `folder` (as
     ``{stem}-{k}/{n}.webp``, addressed as ``{url}/{stem}-{k}/{n}.webp`` from the page) and put
-    the explorer's HTML in place of its output (in place). Returns one entry per frame written:
-    ``{"sha256", "bytes", "smallest_text_pt", "dpi"}``."""
+    the explorer's HTML in place of its output, its fallback output removed (in place). Returns
+    one entry per frame written: ``{"sha256", "bytes", "smallest_text_pt", "dpi"}``."""
+    from ..explorers._fallback import is_fallback
     folder, written, count = Path(folder), [], 0
     for cell in nb.cells:
+        if "outputs" in cell:       # the explorer's fallback for a reopened notebook: not shown here
+            cell["outputs"] = [output for output in cell["outputs"] if not is_fallback(output)]
         for output in cell.get("outputs", []):
             data = output.get("data", {})
             if MIME not in data:
