@@ -14,7 +14,8 @@ from ..flatness import plan_robot
 from ..simulation import simulate
 from ..style import PALETTE, course_subplots, curve_style
 from ..trajectory import feedforward, poly_trajectory
-from ._base import Explorer, int_slider, rescale, slider
+from ._base import Explorer, int_slider, slider
+from .limits import rescale
 
 __all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robot_planner_explorer",
            "drive_robot"]
@@ -89,7 +90,7 @@ def planner_explorer() -> Explorer:
         for line in h["marks"]:
             line.set_xdata([r["T"], r["T"]])
         rescale(h["ax_y"], h["ax_u"])
-        rescale(h["ax_u"], axis="x")          # the shared time axis [0, 2 T], from 0 on
+        rescale(h["ax_u"], axis="x", fill=1.0)   # the shared time axis: exactly [0, 2 T] at rest
 
     def readout(r):
         speed = np.abs(np.gradient(r["yd"], r["t"]))
