@@ -24,6 +24,8 @@ __all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robo
 PLANNER_PLANT = dict(m=1.0, d=0.5, k=2.0)
 #: the largest target coordinate [m] and end speed [m/s] of the robot planner (sliders: 6 m, 2 m/s)
 ROBOT_RANGE = 1e6
+#: height over width of the robot planner's path axes (x1 and x2 drawn on one scale)
+PATH_BOX = 0.75
 
 
 def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0, r: int = 2,
@@ -188,6 +190,21 @@ def _arrow_tip(points, tx: float, ty: float, th: float) -> np.ndarray:
     return np.array([[tx + length * np.cos(th), ty + length * np.sin(th)]])
 
 
+def _same_scale(ax) -> None:
+    """Widen the narrower of the axes' limits about its middle, so that a metre is as long on
+    x2 as on x1 in the box of fixed aspect: limits set from the data alone (`rescale`), not by
+    matplotlib's equal aspect, which adjusts them at each draw from where the layout put the
+    axes (the figure of a setting then depended on the figures drawn before)."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    ratio = ax.get_box_aspect()
+    if (y1 - y0) < ratio * (x1 - x0):
+        half = ratio * (x1 - x0) / 2
+        ax.set_ylim((y0 + y1) / 2 - half, (y0 + y1) / 2 + half)
+    else:
+        half = (y1 - y0) / ratio / 2
+        ax.set_xlim((x0 + x1) / 2 - half, (x0 + x1) / 2 + half)
+
+
 def robot_planner_explorer() -> Explorer:
     """Sliders for the target pose: planned path (flatness) and the path the robot drives."""
     def draw(fig):
@@ -201,7 +218,7 @@ def robot_planner_explorer() -> Explorer:
         ax.plot([0], [0], "ko")
         ax.set_xlabel("x1 [m]")
         ax.set_ylabel("x2 [m]")
-        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_box_aspect(PATH_BOX)         # its limits keep x1 and x2 on one scale (_same_scale)
         ax.set_title("path in the plane")
         ax.legend(loc="best", fontsize="small")
         ax.grid(True, alpha=0.4)
@@ -225,7 +242,8 @@ def robot_planner_explorer() -> Explorer:
         tu = r["t"][:r["u"].shape[0]]
         h["u1"].set_data(tu, r["u"][:, 0])
         h["u2"].set_data(tu, r["u"][:, 1])
-        rescale(h["ax_u"], axis="both")
+        rescale(h["ax_u"])
+        rescale(h["ax_u"], axis="x", fill=1.0)   # the time axis: exactly [0, T] at rest
         # the data limits of the path axes from its points, start and target: not relim(), which
         # in newer matplotlib counts the arrow at a place that moves with the view, so the view
         # would widen at every update
@@ -234,7 +252,8 @@ def robot_planner_explorer() -> Explorer:
         tip = _arrow_tip(points, tx, ty, th)
         h["shaft"].set_data(np.linspace(tx, tip[0, 0], 20), np.linspace(ty, tip[0, 1], 20))
         h["ax"].update_datalim(np.vstack([points, tip]))
-        h["ax"].autoscale_view()
+        rescale(h["ax"], axis="both", relim=False)
+        _same_scale(h["ax"])
 
     def readout(r):
         tx, ty, th = r["target"]

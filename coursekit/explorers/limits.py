@@ -50,7 +50,7 @@ def is_moving() -> bool:
     return _MOVING.get()
 
 
-def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8) -> None:
+def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, relim: bool = True) -> None:
     """Fit the view of each of `axes` to the data its artists hold (call it in an update), by
     the module's policy: at rest a function of the data alone, rounded out to a round step;
     while a control moves (`moving`), grown only.
@@ -59,7 +59,9 @@ def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8) ->
     time axis that starts at 0 gets ``line.sticky_edges.x.append(0)``). `axis` is ``"y"``,
     ``"x"`` or ``"both"``; a log axis is fitted in decades. With `min_span`, the view spans at
     least that much, centred on the data: a response that stays at a constant is drawn flat,
-    not its rounding noise magnified. ``fill=1`` fits the data exactly (a time axis).
+    not its rounding noise magnified. ``fill=1`` fits the data exactly (a time axis). With
+    ``relim=False`` the data are the axes' data limits as the update set them
+    (``ax.update_datalim``), not measured from its artists.
     """
     if axis not in ("x", "y", "both"):
         raise ValueError(f"axis must be 'x', 'y' or 'both': received {axis!r}.")
@@ -68,7 +70,8 @@ def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8) ->
                          f"received {fill!r}.")
     min_span = as_scalar(min_span, "min_span")
     for ax in axes:
-        ax.relim()
+        if relim:
+            ax.relim()
         for name in ("xy" if axis == "both" else axis):
             _fit(ax, name, min_span, fill)
 
