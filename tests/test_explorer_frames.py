@@ -434,3 +434,32 @@ def test_after_a_drag_out_and_back_every_limit_is_that_of_a_fresh_explorer(facto
     values = _drag_values(widget, moves=10)
     _, seen = _drag_in_a_kernel(factory, name, values)
     assert seen[0][0] == _fresh_limits(factory, name, values[-1])
+
+
+def test_a_drag_whose_frames_take_longer_than_the_settling_time_is_still_drawn_as_a_drag():
+    """On a busy machine a frame can take longer than SETTLE_S: the next move, coming right after
+    it, belongs to the same drag (drawn while `moving`), not a single step fitted at rest."""
+    import asyncio
+    import time
+
+    from coursekit.explorers import Explorer, slider
+    states = []
+
+    def update(h, r):
+        states.append(limits.is_moving())
+        time.sleep(limits.SETTLE_S * 1.3)           # a slow frame
+        h.set_data([0, 1], [0, r])
+        rescale(h.axes)
+
+    async def drag():
+        e = Explorer(title="slow", controls=dict(a=slider(1.0, 0.0, 5.0, 0.5, "a [1]")),
+                     compute=lambda a: a, draw=lambda fig: fig.subplots().plot([], [])[0], update=update)
+        e.widget
+        states.clear()
+        for value in (1.5, 2.0, 2.5, 3.0):
+            e.controls["a"].value = value
+            await asyncio.sleep(0.005)
+        await asyncio.sleep(limits.SETTLE_S * 1.5)
+
+    asyncio.run(drag())
+    assert states[:4] == [False, True, True, True]     # a first step, then the drag

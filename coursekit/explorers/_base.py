@@ -203,20 +203,23 @@ class Explorer:
         self._send()
 
     def _moved(self) -> None:
-        """A control moved. In a kernel (an event loop runs), moves less than `SETTLE_S` apart are a
-        drag: drawn inside `moving` (the limits only grow), and a frame at rest follows once the
-        controls rest (it sends nothing when it is the frame shown); a single step is drawn at rest."""
+        """A control moved. In a kernel (an event loop runs), a move less than `SETTLE_S` after the
+        last frame ended is part of a drag: drawn inside `moving` (the limits only grow), and a frame
+        at rest follows once the controls rest (it sends nothing when it is the frame shown); a
+        single step is drawn at rest."""
         loop = self._home.loop
         if loop is None or not loop.is_running():
             return self.refresh()
-        now, last, self._last_move = loop.time(), self._last_move, loop.time()
-        if now - last > SETTLE_S:                         # a single step: fitted at once
-            return self.refresh()
-        if self._settle is not None:
-            self._settle.cancel()
-        self._settle = loop.call_later(SETTLE_S, self.refresh)
-        with moving():
-            self.refresh()
+        try:
+            if loop.time() - self._last_move > SETTLE_S:   # a single step: drawn at rest at once
+                return self.refresh()
+            if self._settle is not None:
+                self._settle.cancel()
+            with moving():
+                self.refresh()
+            self._settle = loop.call_later(SETTLE_S, self.refresh)
+        finally:       # from the end of this frame: a slow frame does not split a drag into steps
+            self._last_move = loop.time()
 
     def static_png(self) -> bytes:
         """The figure for the current settings at its natural size (what a static page shows)."""
