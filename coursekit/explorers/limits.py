@@ -8,7 +8,8 @@ padded so that they fill `fill` of the view, each end then moved out to a multip
 step (1, 2 or 5 times a power of ten) no larger than that padding: a slider stepped on changes
 the limits only when the data cross such a multiple, every few steps (each change of the limits
 is a full draw of the figure), and the data fill between ``fill / (2 - fill)`` and `fill` of
-the view (2/3 to 0.8 by default; exactly with ``fill=1``).
+the view (2/3 to 0.8 by default; exactly with ``fill=1``); a vertical axis' limits then move out
+by `Y_EDGE` of their span, so that no tick label sits on the frame's corner.
 
 While a control moves (a drag: moves less than `SETTLE_S` apart; `Explorer` draws those frames
 inside `moving`) the limits only grow, when the data leave them, to leave the data
@@ -25,12 +26,16 @@ import numpy as np
 
 from .._validation import as_scalar
 
-__all__ = ["rescale", "moving", "is_moving", "SETTLE_S", "MOVING_FILL"]
+__all__ = ["rescale", "moving", "is_moving", "SETTLE_S", "MOVING_FILL", "Y_EDGE"]
 
 #: seconds between moves of a control that make them one drag; a frame follows once it rests
 SETTLE_S = 0.3
 #: while a control moves, limits that grow leave the data this fraction of them
 MOVING_FILL = 0.6
+
+#: at rest a vertical axis' rounded limits move out by this part of their span: no tick on the
+#: frame's bottom corner, where the horizontal axis' first label (a time axis' 0) stands
+Y_EDGE = 0.05
 
 _MOVING = contextvars.ContextVar("moving", default=False)
 
@@ -82,13 +87,15 @@ def _round_step(pad: float) -> float:
     return power * max(d for d in (1.0, 2.0, 5.0, 10.0) if d * power <= pad * (1 + 1e-12))
 
 
-def _at_rest(lo: float, hi: float, fill: float) -> tuple[float, float]:
-    """The limits for data in [lo, hi] at rest: padded to `fill`, rounded out to a round step."""
+def _at_rest(lo: float, hi: float, fill: float, edge: float) -> tuple[float, float]:
+    """The limits for data in [lo, hi] at rest: padded to `fill`, rounded out to a round step,
+    then moved out by `edge` of their span."""
     pad = (hi - lo) * (1 / fill - 1) / 2
     if pad <= 0:
         return lo, hi
     step = _round_step(pad)
-    return (math.floor((lo - pad) / step + 1e-9) * step, math.ceil((hi + pad) / step - 1e-9) * step)
+    low, high = math.floor((lo - pad) / step + 1e-9) * step, math.ceil((hi + pad) / step - 1e-9) * step
+    return low - edge * (high - low), high + edge * (high - low)
 
 
 def _fit(ax, name: str, min_span: float, fill: float) -> None:
@@ -110,7 +117,7 @@ def _fit(ax, name: str, min_span: float, fill: float) -> None:
         pad = (hi - lo) * (1 / min(fill, MOVING_FILL) - 1) / 2
         low, high = min(lo - pad, view[0]), max(hi + pad, view[1])
     else:
-        low, high = _at_rest(lo, hi, fill)
+        low, high = _at_rest(lo, hi, fill, Y_EDGE if name == "y" else 0.0)
     with np.errstate(all="ignore"):   # sticky edges: no room past them (a time axis' start)
         sticky = scale.transform([s for a in ax.get_children() for s in getattr(a.sticky_edges, name)])
     low = max([low, *(s for s in sticky if low < s <= lo)])
