@@ -32,7 +32,7 @@ __all__ = ["LECTURE_TEXT_SIZES", "DISPLAY_ID", "lecture_text_html", "show_lectur
 #: the CSS variables lecture mode sets on the notebook, and their values (JupyterLab's
 #: defaults: content 14px, code 13px, UI 13px, prompt 64px; ipywidgets: 13px text,
 #: 28px rows, 80px labels, 300px controls, 16px slider handles); about one and a half times
-#: the defaults, the explorers' lecture sizes (coursekit/explorers/_view.py) for widgets
+#: the defaults, the explorers' lecture sizes (coursekit/explorers/view.css) for widgets
 LECTURE_TEXT_SIZES = {
     "--jp-content-font-size1": "21px",
     "--jp-code-font-size": "20px",

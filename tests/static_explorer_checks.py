@@ -11,8 +11,8 @@ folder its frames are read from, and for every explorer on it
 * drags each range input with the mouse across its track: the figure and its alt text change,
   each value the hand passes is one swap of the frame (a count, not a time), the polite live
   region announces the figure once the slider rests, and the figure shown is, pixel for pixel,
-  the one the explorer renders in this process for the settings the slider snapped to (but for
-  the robot planner's equal-aspect path: `test_static_explorers.assert_shows`).
+  the one the explorer renders in this process for the settings the slider snapped to
+  (`test_static_explorers.assert_shows`).
 """
 
 from __future__ import annotations

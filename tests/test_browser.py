@@ -67,6 +67,18 @@ DRAG_NOTEBOOKS = {
     "msd_explorer.ipynb": (["%matplotlib inline\nfrom coursekit.explorers.ch1 import msd_explorer",
                             "explorer = msd_explorer()\nexplorer"], "explorer"),
 }
+PLANNER_NOTEBOOK = "planner_explorer.ipynb"
+PLANNER_CELLS = ["%matplotlib inline\nfrom coursekit.explorers.ch2 import planner_explorer",
+                 "explorer = planner_explorer()\nexplorer"]
+# run in the planner's kernel: the limits shown, and a fresh explorer's after one move to its T
+_PLANNER_LIMITS_CODE = """\
+import json as _json
+_fresh = planner_explorer()
+_fresh.controls["T"].value = explorer.controls["T"].value
+_limits = lambda e: [[list(map(float, ax.get_xlim())), list(map(float, ax.get_ylim()))] for ax in e.fig.axes]
+print(_json.dumps({"T": explorer.params["T"], "end": float(explorer.result["t"][-1]),
+                   "shown": _limits(explorer), "fresh": _limits(_fresh)}))
+"""
 
 _EXPLORER_IMAGES_JS = f"""() => Array.from(document.querySelectorAll(
     '{lab_h.EXPLORER.replace(", ", " img, ")} img')).map(i => i.src)"""
@@ -116,6 +128,7 @@ def lab(tmp_path_factory):
         lab_h.write_notebook(root / name, cells)
     lab_h.write_notebook(root / PLOTS_BESIDE_EXPLORER, [*DRAG_NOTEBOOKS["msd_explorer.ipynb"][0], _PLOT_CELL_CODE])
     lab_h.write_notebook(root / KEYS_NOTEBOOK, KEYS_CELLS)
+    lab_h.write_notebook(root / PLANNER_NOTEBOOK, PLANNER_CELLS)
     with lab_h.running_lab(root, base) as url:
         yield url
 
@@ -267,6 +280,27 @@ def _check_drag(page, name: str, shown: str) -> None:
         f"{reference['params']} ({differ} pixels differ)")
     errors = lab_h.error_outputs(page)
     assert not errors, f"{name}: an error was reported during the drag:\n" + "\n----\n".join(errors)
+
+
+def test_the_planner_s_time_axis_ends_with_its_data_after_a_long_drag_and_key_steps(page, opened):
+    """Issue 32: after a drag of T to 8.6 s the time axis ran to ~23 s with data to 17.6 s, and
+    key steps kept it there. After a drag to the far end and after each key step, the figure's
+    limits are those of a fresh explorer for the same T, its time axis [0, 2 T]."""
+    with opened(PLANNER_NOTEBOOK):
+        _run_without_errors(page, PLANNER_NOTEBOOK)
+        slider = lab_h.first_slider(page)
+        lab_h.install_probe(page)
+        lab_h.drag(page, slider, seconds=2.0, trips=0.5)          # out to the far end, released there
+        for key in (None, "ArrowLeft", "ArrowLeft"):
+            if key:
+                slider.locator(".noUi-handle").first.focus()
+                page.keyboard.press(key)
+            lab_h.wait_until_quiet(page, quiet_ms=1500, timeout=SLIDER_TIMEOUT_S)
+            seen = json.loads(lab_h.execute_in_kernel(page, _PLANNER_LIMITS_CODE))
+            assert seen["T"] > 6.0, seen["T"]                      # a long drag
+            assert seen["end"] == pytest.approx(2 * seen["T"])
+            assert seen["shown"][1][0] == pytest.approx([0.0, seen["end"]]), (key, seen)
+            assert seen["shown"] == seen["fresh"], (key, seen)
 
 
 # what JupyterLab's widget manager sends a kernel that has not imported ipywidgets when it

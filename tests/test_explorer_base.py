@@ -231,3 +231,24 @@ def test_rescale_fits_the_view_to_data_moved_by_an_update():
     assert lo <= -5 and hi >= 50
     rescale(ax, axis="x")
     assert ax.get_xlim()[1] >= 10
+
+
+def test_the_widget_s_script_and_style_sheet_are_files_declared_as_package_data():
+    """anywidget reads them from the package's folder: a wheel without them shows no figure."""
+    import ast
+    import fnmatch
+    from pathlib import Path
+
+    from coursekit.explorers import _view
+    root = Path(_view.__file__).resolve().parents[2]
+    pyproject = (root / "pyproject.toml").read_text(encoding="utf-8")
+    section = pyproject.split("[tool.setuptools.package-data]", 1)[1].split("\n[", 1)[0]
+    declared = re.search(r'^"coursekit\.explorers"\s*=\s*(\[.*?\])', section, re.M)
+    assert declared, "pyproject.toml declares no package data for coursekit.explorers"
+    patterns = ast.literal_eval(declared.group(1))
+    view = _view.FigureView()
+    for path, shipped in ((_view.VIEW_JS, view._esm), (_view.VIEW_CSS, view._css)):
+        assert path.parent == Path(_view.__file__).parent and path.stat().st_size > 0
+        assert any(fnmatch.fnmatch(path.name, p) for p in patterns), (path.name, patterns)
+        assert str(shipped) == path.read_text(encoding="utf-8")
+    assert "export default" in str(view._esm) and ".ck-explorer" in str(view._css)

@@ -88,3 +88,27 @@ def test_drive_robot_agrees_with_an_ode_solver_on_random_sampled_inputs(samples,
     x0 = rng.normal(size=3)
     ode = _ode_interval_by_interval(t, u, x0)
     np.testing.assert_allclose(ch2.drive_robot(t, u, x0), ode, atol=1e-10 * max(1.0, np.abs(ode).max()))
+
+
+def test_the_robot_planner_s_path_is_on_one_scale_with_limits_a_draw_keeps_and_labels_whole_on_the_site():
+    """Issue 34: the path's equal aspect without a full draw at every frame. Its limits are set
+    by the update from the settings (x1 and x2 on one scale in a box of fixed aspect), so a draw
+    does not move them (matplotlib's equal aspect did, from where the layout put the axes), and
+    the website's column shows every label whole."""
+    from layout_check import text_problems
+
+    from coursekit.tools.site_figures import drawn_for_the_column
+    e = ch2.robot_planner_explorer()
+    ax = e.handles["ax"]
+    for settings in ({}, {"x_T": -6.0, "y_T": 6.0}, {"T": 20.0, "speed": 2.0}, {"heading_deg": -180.0}):
+        for name, value in settings.items():
+            e.controls[name].value = value
+        limits = ax.get_xlim(), ax.get_ylim()
+        e.frames.reset()
+        e.frames.frame()                                          # a full draw
+        assert (ax.get_xlim(), ax.get_ylim()) == limits, settings
+        box = ax.get_window_extent()
+        metre_x, metre_y = box.width / np.ptp(limits[0]), box.height / np.ptp(limits[1])
+        assert metre_x == pytest.approx(metre_y, rel=1e-3), settings
+        with drawn_for_the_column(e.fig, e.natural_dpi):
+            assert text_problems(e.fig) == [], settings

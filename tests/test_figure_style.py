@@ -192,8 +192,8 @@ def _resolve(value: str, css: str) -> str:
 
 
 def test_explorer_text_colours_keep_4_5_to_1_in_jupyterlab_s_themes_and_elsewhere():
-    from coursekit.explorers._view import _CSS
-    colours = re.findall(r"(?<![-\w])color:\s*([^;}]+)", _CSS)
+    from coursekit.explorers._view import VIEW_CSS
+    colours = re.findall(r"(?<![-\w])color:\s*([^;}]+)", VIEW_CSS.read_text(encoding="utf-8"))
     assert colours, "the explorer's CSS sets no text colour: nothing to check"
     themes, lab = _themes(), _lab_variables()
     assert set(themes) == {"light", "dark"}, "JupyterLab's themes are not installed (the lab extra)"

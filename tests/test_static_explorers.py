@@ -126,24 +126,13 @@ def _one_move(factory, settings: dict, *, column: bool) -> tuple[np.ndarray, str
         return np.asarray(fresh.frames.canvas.buffer_rgba())[..., :3].astype(int), fresh.alt
 
 
-def _equal_aspect(factory) -> bool:
-    """Whether the explorer has axes of a fixed aspect whose data limits matplotlib adjusts at each
-    draw (``adjustable="datalim"``: the robot planner's path): their limits, and the layout around
-    them, depend on the draws before, so two renderings of the same settings differ (issue 34,
-    second half: fixed limits for the robot planner)."""
-    return any(ax.get_aspect() != "auto" and ax.get_adjustable() == "datalim" for ax in factory().fig.axes)
-
-
 def assert_shows(factory, settings: dict, shown: np.ndarray, *, column: bool) -> str:
     """Assert that `shown` (pixels) is the figure of `settings`: equal, within 2 levels per pixel,
-    to a fresh explorer's after one move to them. Not for an explorer with equal-aspect axes
-    (`_equal_aspect`, the robot planner): its path's limits follow the draws before, so a fresh
-    rendering differs from the page's by up to a tenth of the pixels (measured on the slides); its
-    shape and text alternative are still checked. Returns the fresh explorer's alt text."""
+    to a fresh explorer's after one move to them (every explorer, the robot planner's path of one
+    scale too: its limits depend on the settings alone). Returns the fresh explorer's alt text."""
     reference, alt = _one_move(factory, settings, column=column)
     assert shown.shape == reference.shape, settings
-    if not _equal_aspect(factory):
-        assert np.abs(shown - reference).max() <= 2, settings      # a blit's antialiasing: 1 level
+    assert np.abs(shown - reference).max() <= 2, settings      # a blit's antialiasing: 1 level
     return alt
 
 
@@ -158,8 +147,9 @@ class _natural:
         return False
 
 
-@pytest.mark.parametrize("factory, column", [(ch2.planner_explorer, True), (ch1.euler_explorer, False)],
-                         ids=["planner-site", "euler-slides"])
+@pytest.mark.parametrize("factory, column", [(ch2.planner_explorer, True), (ch1.euler_explorer, False),
+                                             (ch2.robot_planner_explorer, True)],
+                         ids=["planner-site", "euler-slides", "robot-planner-site"])
 def test_each_frame_is_the_figure_of_one_move_from_the_defaults(factory, column):
     """Rendered together, in the order the module draws them (blitting where it can), each frame
     is what a fresh explorer shows after one move to its settings, laid out from where the

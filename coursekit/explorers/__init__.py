@@ -3,9 +3,10 @@
 Each explorer is a pure ``compute`` function (tested without a browser) plus a thin
 `Explorer` built by a ``*_explorer()`` function. The names below are the kit for writing
 one (docs/extending.md): `Explorer`, its controls `slider`, `int_slider` and `dropdown`, and
-`rescale`, which fits an axes' limits to its data.
+`rescale`, which fits an axes' limits to its data (the policy: the module ``limits``).
 """
 
-from ._base import Explorer, dropdown, int_slider, rescale, slider
+from ._base import Explorer, dropdown, int_slider, slider
+from .limits import rescale
 
 __all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale"]

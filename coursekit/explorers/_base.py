@@ -3,10 +3,10 @@
 An explorer is a set of controls and plain functions: ``compute(**params)``, pure numerics
 (unit-tested without a browser); ``draw(fig)``, which builds axes and empty artists once and
 returns handles; ``update(handles, result)``, which moves the artists' data and sets the
-limits (`rescale`); and optionally ``readout(result)``, the numbers worth reading, shown next
-to the controls. A `FrameRenderer` draws each frame, blitting while the axes stay (while a
-hand moves a control `rescale` only grows the limits; one frame fits them once it rests); a
-`FigureView` shows it at the size and pixel ratio the browser reports. Callbacks run on the
+limits (`rescale`, whose policy is the module `limits`); and optionally ``readout(result)``,
+the numbers worth reading, shown next to the controls. A `FrameRenderer` draws each frame,
+blitting while the axes stay (the frames of a drag are drawn inside `limits.moving`, and one
+frame follows once the controls rest); a `FigureView` shows it at the size and pixel ratio the browser reports. Callbacks run on the
 kernel's main thread (`HomeThread`). The display data also carry a static PNG, for pages
 without a kernel (GitHub, the website), and a fallback output comes before them (`_fallback`).
 """
@@ -14,30 +14,23 @@ without a kernel (GitHub, the website), and a fallback output comes before them 
 from __future__ import annotations
 
 import base64
-import contextvars
 import functools
 import html
 from typing import Any, Callable
 
-import numpy as np
 
 from .._validation import as_scalar
 from ..describe import describe_figure
 from ._fallback import publish_fallback
 from ._frames import FrameRenderer
+from .limits import SETTLE_S, moving
 
-__all__ = ["Explorer", "slider", "int_slider", "dropdown", "rescale"]
+__all__ = ["Explorer", "slider", "int_slider", "dropdown"]
 
 #: an explorer is never shrunk below this fraction of its natural size to fit the screen
 MIN_SCALE = 0.45
 #: in lecture mode an explorer grows up to this factor to fill the room it has
 LECTURE_MAX_SCALE = 2.0
-#: seconds the controls rest before the limits are fitted again; till then they only grow, to
-#: leave the data MOVING_FILL of them
-SETTLE_S, MOVING_FILL = 0.3, 0.6
-
-#: True while the frame being drawn follows a control that moves (set by `Explorer`)
-_moving = contextvars.ContextVar("moving", default=False)
 
 
 def _range(value, min, max, step, description):
@@ -89,60 +82,6 @@ def dropdown(options, value, description: str):
         raise ValueError(f"value must be one of the options {options}: received {value!r}.")
     _range(0, 0, 1, 1, description)
     return widgets.Dropdown(options=options, value=value, description=description, **_STYLE)
-
-
-def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, keep: float = 0.5) -> None:
-    """Fit the view of each of `axes` to the data its artists hold (call it in an update).
-
-    The limits change only when they must: when the data leave them, or fill less than
-    `keep` of them. They are then set so that the data fill `fill` of the view, so a
-    slider moved on in the same direction changes the axes every few steps, not at each
-    (each change of the axes is a full draw of the figure). While a hand drags a control of
-    an `Explorer` (moves less than `SETTLE_S` apart) the limits only grow, leaving the data
-    `MOVING_FILL` of them, and are fitted as above once it rests. They never go past an artist's
-    sticky edges (matplotlib's ``Artist.sticky_edges``: a time axis that starts at 0 gets
-    ``line.sticky_edges.x.append(0)``). `axis` is ``"y"``, ``"x"`` or ``"both"``. With
-    `min_span`, the view spans at least that much, centred on the data: a response that stays
-    at a constant is drawn flat, not its rounding noise magnified.
-    """
-    if axis not in ("x", "y", "both"):
-        raise ValueError(f"axis must be 'x', 'y' or 'both': received {axis!r}.")
-    if not 0 < keep < fill <= 1:
-        raise ValueError(f"fill and keep must satisfy 0 < keep < fill <= 1: received fill={fill!r}, keep={keep!r}.")
-    min_span = as_scalar(min_span, "min_span")
-    for ax in axes:
-        ax.relim()
-        for name in ("xy" if axis == "both" else axis):
-            _fit(ax, name, min_span, fill, keep)
-
-
-def _fit(ax, name: str, min_span: float, fill: float, keep: float) -> None:
-    """`rescale` for one axis of `ax`, in the axis' scale (decades on a log axis)."""
-    scale = getattr(ax, f"{name}axis").get_transform()
-    with np.errstate(all="ignore"):
-        lo, hi = scale.transform(getattr(ax.dataLim, f"interval{name}"))
-        view = np.sort(scale.transform(getattr(ax, f"get_{name}lim")()))
-    if not (np.isfinite(lo) and np.isfinite(hi)):
-        return                                   # no data yet (or none a log axis can show)
-    if hi - lo < min_span:
-        lo, hi = (lo + hi - min_span) / 2, (lo + hi + min_span) / 2
-    if not hi - lo > 1e-9 * max(abs(lo), abs(hi)):      # a constant: 5 % of it either way (or 0.05)
-        half = 0.05 * (abs(lo) or 1.0)
-        lo, hi = lo - half, hi + half
-    auto = getattr(ax, f"get_autoscale{name}_on")()
-    moving = _moving.get() and not auto      # a hand moves a control: the limits only grow
-    if moving:
-        keep, fill = 0.0, min(fill, MOVING_FILL)
-    if auto or lo < view[0] or hi > view[1] or hi - lo < keep * (view[1] - view[0]):
-        pad = (hi - lo) * (1 / fill - 1) / 2
-        low, high = lo - pad, hi + pad
-        if moving:
-            low, high = min(low, view[0]), max(high, view[1])
-        with np.errstate(all="ignore"):   # sticky edges: no room past them (a time axis' start)
-            sticky = scale.transform([s for a in ax.get_children() for s in getattr(a.sticky_edges, name)])
-        low = max([low, *(s for s in sticky if low < s <= lo)])
-        high = min([high, *(s for s in sticky if hi <= s < high)])
-        getattr(ax, f"set_{name}lim")(*scale.inverted().transform([low, high]))
 
 
 class Explorer:
@@ -265,23 +204,23 @@ class Explorer:
         self._send()
 
     def _moved(self) -> None:
-        """A control moved. In a kernel (an event loop runs), while moves come less than `SETTLE_S`
-        apart (a drag) the limits only grow (`rescale`), and a frame with fitted limits follows once
-        the controls rest (it sends nothing when it is the frame shown); else it is fitted at once."""
+        """A control moved. In a kernel (an event loop runs), a move less than `SETTLE_S` after the
+        last frame ended is part of a drag: drawn inside `moving` (the limits only grow), and a frame
+        at rest follows once the controls rest (it sends nothing when it is the frame shown); a
+        single step is drawn at rest."""
         loop = self._home.loop
         if loop is None or not loop.is_running():
             return self.refresh()
-        now, last, self._last_move = loop.time(), self._last_move, loop.time()
-        if now - last > SETTLE_S:                         # a single step: fitted at once
-            return self.refresh()
-        if self._settle is not None:
-            self._settle.cancel()
-        self._settle = loop.call_later(SETTLE_S, self.refresh)
-        moving = _moving.set(True)
         try:
-            self.refresh()
-        finally:
-            _moving.reset(moving)
+            if loop.time() - self._last_move > SETTLE_S:   # a single step: drawn at rest at once
+                return self.refresh()
+            if self._settle is not None:
+                self._settle.cancel()
+            with moving():
+                self.refresh()
+            self._settle = loop.call_later(SETTLE_S, self.refresh)
+        finally:       # from the end of this frame: a slow frame does not split a drag into steps
+            self._last_move = loop.time()
 
     def static_png(self) -> bytes:
         """The figure for the current settings at its natural size (what a static page shows)."""

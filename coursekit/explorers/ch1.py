@@ -15,7 +15,8 @@ from ..simulation import simulate
 from ..systems import StateSpace
 from ..stability import format_poles
 from ..style import PALETTE, course_subplots, curve_style
-from ._base import Explorer, dropdown, rescale, slider
+from ._base import Explorer, dropdown, slider
+from .limits import rescale
 
 __all__ = ["EULER_EXAMPLES", "euler_compute", "euler_explorer", "msd_compute", "msd_explorer"]
 

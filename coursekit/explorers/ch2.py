@@ -14,7 +14,8 @@ from ..flatness import plan_robot
 from ..simulation import simulate
 from ..style import PALETTE, course_subplots, curve_style
 from ..trajectory import feedforward, poly_trajectory
-from ._base import Explorer, int_slider, rescale, slider
+from ._base import Explorer, int_slider, slider
+from .limits import rescale
 
 __all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robot_planner_explorer",
            "drive_robot"]
@@ -23,6 +24,8 @@ __all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robo
 PLANNER_PLANT = dict(m=1.0, d=0.5, k=2.0)
 #: the largest target coordinate [m] and end speed [m/s] of the robot planner (sliders: 6 m, 2 m/s)
 ROBOT_RANGE = 1e6
+#: height over width of the robot planner's path axes (x1 and x2 drawn on one scale)
+PATH_BOX = 0.75
 
 
 def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0, r: int = 2,
@@ -89,7 +92,7 @@ def planner_explorer() -> Explorer:
         for line in h["marks"]:
             line.set_xdata([r["T"], r["T"]])
         rescale(h["ax_y"], h["ax_u"])
-        rescale(h["ax_u"], axis="x")          # the shared time axis [0, 2 T], from 0 on
+        rescale(h["ax_u"], axis="x", fill=1.0)   # the shared time axis: exactly [0, 2 T] at rest
 
     def readout(r):
         speed = np.abs(np.gradient(r["yd"], r["t"]))
@@ -187,6 +190,33 @@ def _arrow_tip(points, tx: float, ty: float, th: float) -> np.ndarray:
     return np.array([[tx + length * np.cos(th), ty + length * np.sin(th)]])
 
 
+def _rescale_off_ticks(ax, names: str, **kwargs) -> None:
+    """`rescale` of the axes `names` ("x", "y" or "xy"), and limits it changed moved out by 5 % of
+    their span: at rest it rounds them to a round step, where a tick falls on the frame and, at a
+    corner, the first tick labels of the two axes meet (large fonts). Limits kept stay as they are."""
+    before = {name: getattr(ax, f"get_{name}lim")() for name in names}
+    rescale(ax, axis="both" if names == "xy" else names, **kwargs)
+    for name, old in before.items():
+        low, high = getattr(ax, f"get_{name}lim")()
+        if (low, high) != old:
+            getattr(ax, f"set_{name}lim")(low - 0.05 * (high - low), high + 0.05 * (high - low))
+
+
+def _same_scale(ax) -> None:
+    """Widen the narrower of the axes' limits about its middle, so that a metre is as long on
+    x2 as on x1 in the box of fixed aspect: limits set from the data alone (`rescale`), not by
+    matplotlib's equal aspect, which adjusts them at each draw from where the layout put the
+    axes (the figure of a setting then depended on the figures drawn before)."""
+    (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
+    ratio = ax.get_box_aspect()
+    if (y1 - y0) < ratio * (x1 - x0):
+        half = ratio * (x1 - x0) / 2
+        ax.set_ylim((y0 + y1) / 2 - half, (y0 + y1) / 2 + half)
+    else:
+        half = (y1 - y0) / ratio / 2
+        ax.set_xlim((x0 + x1) / 2 - half, (x0 + x1) / 2 + half)
+
+
 def robot_planner_explorer() -> Explorer:
     """Sliders for the target pose: planned path (flatness) and the path the robot drives."""
     def draw(fig):
@@ -195,14 +225,11 @@ def robot_planner_explorer() -> Explorer:
         driven, = ax.plot([], [], alpha=0.8, label="driven (model 1.10)", **curve_style(0))
         goal = ax.quiver([0.0], [0.0], [1.0], [0.0], color=PALETTE["vermillion"], scale=12, label="target pose",
                          zorder=3)
-        # an unseen line along the arrow, so the legend's "best" place keeps clear of all of it
-        shaft, = ax.plot([], [], alpha=0.0, label="_arrow")
         ax.plot([0], [0], "ko")
         ax.set_xlabel("x1 [m]")
         ax.set_ylabel("x2 [m]")
-        ax.set_aspect("equal", adjustable="datalim")
+        ax.set_box_aspect(PATH_BOX)         # its limits keep x1 and x2 on one scale (_same_scale)
         ax.set_title("path in the plane")
-        ax.legend(loc="best", fontsize="small")
         ax.grid(True, alpha=0.4)
         u1, = ax_u.plot([], [], label="speed u1 [m/s]", **curve_style(0))
         u2, = ax_u.plot([], [], label="turn rate u2 [rad/s]", **curve_style(1))
@@ -211,9 +238,12 @@ def robot_planner_explorer() -> Explorer:
         ax_u.set_xlabel("time t [s]")
         ax_u.set_ylabel("u1 [m/s], u2 [rad/s]")
         ax_u.set_title("inputs psi_u (2.102)")
-        ax_u.legend(loc="best", fontsize="small")
+        # one legend below the axes: out of the data, drawn with the background, not at every
+        # frame (a "best" place inside the axes was searched anew at each frame: half its time)
+        fig.legend(handles=[path, driven, goal, u1, u2], loc="outside lower center", ncols=3,
+                   fontsize="small")
         ax_u.grid(True, alpha=0.4)
-        return dict(ax=ax, ax_u=ax_u, path=path, driven=driven, goal=goal, shaft=shaft, u1=u1, u2=u2)
+        return dict(ax=ax, ax_u=ax_u, path=path, driven=driven, goal=goal, u1=u1, u2=u2)
 
     def update(h, r):
         h["path"].set_data(r["path"][:, 0], r["path"][:, 1])
@@ -224,16 +254,17 @@ def robot_planner_explorer() -> Explorer:
         tu = r["t"][:r["u"].shape[0]]
         h["u1"].set_data(tu, r["u"][:, 0])
         h["u2"].set_data(tu, r["u"][:, 1])
-        rescale(h["ax_u"], axis="both")
+        _rescale_off_ticks(h["ax_u"], "y")
+        rescale(h["ax_u"], axis="x", fill=1.0)   # the time axis: exactly [0, T] at rest
         # the data limits of the path axes from its points, start and target: not relim(), which
         # in newer matplotlib counts the arrow at a place that moves with the view, so the view
         # would widen at every update
         h["ax"].ignore_existing_data_limits = True
         points = np.vstack([r["path"][:, :2], r["driven"][:, :2], [[0.0, 0.0], [tx, ty]]])
         tip = _arrow_tip(points, tx, ty, th)
-        h["shaft"].set_data(np.linspace(tx, tip[0, 0], 20), np.linspace(ty, tip[0, 1], 20))
         h["ax"].update_datalim(np.vstack([points, tip]))
-        h["ax"].autoscale_view()
+        _rescale_off_ticks(h["ax"], "xy", relim=False)
+        _same_scale(h["ax"])
 
     def readout(r):
         tx, ty, th = r["target"]

@@ -19,7 +19,8 @@ from ..simulation import simulate, simulate_batch
 from ..systems import StateSpace
 from ..stability import format_poles
 from ..style import PALETTE, course_subplots, curve_style
-from ._base import Explorer, rescale, slider
+from ._base import Explorer, slider
+from .limits import rescale
 
 __all__ = [
     "pair_poles",

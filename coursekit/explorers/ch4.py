@@ -20,7 +20,8 @@ from ..observers import observer_system
 from ..simulation import simulate
 from ..stability import format_poles
 from ..style import PALETTE, course_subplots, curve_style
-from ._base import Explorer, rescale, slider
+from ._base import Explorer, slider
+from .limits import rescale
 
 __all__ = ["KALMAN_TRUE_Q", "KALMAN_TRUE_R", "observer_noise_compute", "observer_noise_explorer", "kalman_tuning_compute",
            "kalman_tuning_explorer"]
