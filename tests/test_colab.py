@@ -66,6 +66,13 @@ def test_an_install_cell_without_repository_shows_no_install_line():
         assert "OWNER/NAME" not in first_code.source, path.name
 
 
+@pytest.mark.parametrize("repository", [None, "https://github.com/course/coursekit"])
+def test_the_install_cell_s_comment_says_what_it_does(repository):
+    """Without an address the cell stops with a message: its comment must not promise an install."""
+    comment = "".join(line for line in install_cell_source(repository).splitlines(True) if line.startswith("#"))
+    assert ("this cell installs it" in comment) == (repository is not None), comment
+
+
 @pytest.mark.parametrize("bad", ["github.com/a/b", "http://github.com/a/b", "https://github.com/a b", 3])
 def test_install_cell_refuses_what_is_not_an_https_address(bad):
     with pytest.raises(ValueError, match="repository must be the https address"):

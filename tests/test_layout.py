@@ -6,12 +6,11 @@ matplotlib.use("Agg")
 
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
-from matplotlib.backends.backend_agg import FigureCanvasAgg  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.layout_engine import ConstrainedLayoutEngine, TightLayoutEngine  # noqa: E402
 
 import coursekit as ck  # noqa: E402
-from layout_check import drawn_strings, legend_problems, text_problems  # noqa: E402
+from layout_check import legend_problems, text_problems  # noqa: E402
 
 
 def _crowded(fit: bool):

@@ -28,15 +28,17 @@ __all__ = ["INSTALL_MARK", "install_cell_source", "cell_repository", "with_insta
 #: the cell metadata ``coursekit`` value that marks the install cell
 INSTALL_MARK = INSTALL
 
-_HEADER = ("# Colab and other hosted notebooks start without coursekit: this cell installs it there.\n"
-           "# Where coursekit is installed (your own JupyterLab, Binder, CI) it does nothing.\n")
+_DOES_NOTHING = "# Where coursekit is installed (your own JupyterLab, Binder, CI) it does nothing.\n"
 
-_WITH_REPOSITORY = _HEADER + '''import importlib.util, subprocess, sys
+_WITH_REPOSITORY = ("# Colab and other hosted notebooks start without coursekit: this cell installs it there.\n"
+                    + _DOES_NOTHING) + '''import importlib.util, subprocess, sys
 if importlib.util.find_spec("coursekit") is None:
     subprocess.run([sys.executable, "-m", "pip", "install", "--quiet",
                     "coursekit @ git+{repository}"], check=True)'''
 
-_WITHOUT_REPOSITORY = _HEADER + '''import importlib.util
+_WITHOUT_REPOSITORY = ("# Colab and other hosted notebooks start without coursekit: this cell stops there and says\n"
+                       "# where to read how to install it (an instructor's `python -m coursekit colab` installs here).\n"
+                       + _DOES_NOTHING) + '''import importlib.util
 if importlib.util.find_spec("coursekit") is None:
     raise ModuleNotFoundError(
         "coursekit is missing: install it from the course repository these notebooks come from "

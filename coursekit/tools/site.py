@@ -60,7 +60,7 @@ __all__ = [
     "FIGURE_RECORD",
     "SITE_FIGURES",
     "figure_text_sizes",
-    "WIDGET_VIEW", "ALT", "SMALLEST_TEXT",
+    "SMALLEST_TEXT",
 ]
 
 #: the theme's search button says "Search" to a screen reader but shows "Search ... Ctrl+K": its
