@@ -951,10 +951,11 @@ feedback("exercises.check_kalman_decision", "rank the string '2'", lambda: ex.ch
          r"rank must be a whole number, not text: received the string '2'; type the number without quotes")
 
 # ---------------------------------------------------------------------------
-# each chapter's explorer functions: its own file tests/bad_input_chN.py (docs/extending.md),
-# which takes bad, ok, scalar_cases, ... from this module
-for _path in sorted(Path(__file__).parent.glob("bad_input_ch*.py")):
-    importlib.import_module(_path.stem)
+# each chapter's explorer functions: its own file of cases tests/cases_chN.py (docs/extending.md),
+# which takes bad, ok, scalar_cases, ... from this module; CHAPTER_CASES are those modules, where
+# the tests of exercises and explorers also find a chapter's WRONG_ANSWERS and STATED
+CHAPTER_CASES = [importlib.import_module(_path.stem)
+                 for _path in sorted(Path(__file__).parent.glob("cases_ch*.py"), key=lambda p: int(p.stem[8:]))]
 
 # ---------------------------------------------------------------------------
 # the worker

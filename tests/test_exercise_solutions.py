@@ -139,7 +139,7 @@ def test_unanswered_exercises_say_not_yet_and_every_solution_is_correct(path):
             assert isinstance(result, CheckResult) and bool(result) is True, f"{where}: {result!r}\n{out}"
             assert "Correct:" in out and "Not yet" not in out, f"{where}: {out}"
             checked += 1
-    assert checked == sum(map(_is_exercise_cell, cells)) >= 4
+    assert checked == sum(map(_is_exercise_cell, cells)) >= 1      # a chapter may have one exercise (extending.md)
 
 
 def test_run_all_in_a_kernel_leaves_no_out_line_and_answers_nothing():

@@ -14,6 +14,9 @@ import sympy as sp
 import coursekit.exercises as ex
 from coursekit.exercises._feedback import CheckResult
 from coursekit.placement import place
+from coursekit.tools.chapters import chapter_modules
+
+from bad_input_cases import CHAPTER_CASES
 
 MSD = ex.MSD
 CP = ex.COMPARTMENT
@@ -282,6 +285,9 @@ def _numbers_in(text: str) -> set[str]:
     return set(re.findall(r"(?<![\w^.])-?\d+(?:\.\d+)?(?:e-?\d+)?", text))
 
 
+WRONG += [case for module in CHAPTER_CASES for case in getattr(module, "WRONG_ANSWERS", [])]   # a chapter's own
+
+
 @pytest.mark.parametrize("name, args, words", WRONG, ids=[f"{w[0]}-{w[2]}" for w in WRONG])
 def test_wrong_answer_is_named_and_solution_not_printed(name, args, words, capsys):
     assert _verdict(getattr(ex, name)(*args)) is False
@@ -331,7 +337,7 @@ def test_leak_detector_sees_numbers_but_not_equation_references():
 
 def test_every_checker_has_wrong_answer_cases():
     checkers = {n for n in ex.__all__ if n.startswith("check_")}
-    assert len(checkers) == 18
+    assert len([n for m in chapter_modules("exercises")[:4] for n in m.__all__ if n.startswith("check_")]) == 18
     assert checkers == {case[0] for case in WRONG}
 
 

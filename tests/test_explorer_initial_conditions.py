@@ -15,6 +15,7 @@ import pytest
 
 from coursekit.explorers.ch1 import EULER_EXAMPLES
 from coursekit.tools.chapters import explorer_factories
+from bad_input_cases import CHAPTER_CASES
 from test_figure_layout import settings
 
 EXPLORERS = explorer_factories()
@@ -66,6 +67,7 @@ STATED = {
     "ch4.kalman_tuning_explorer": lambda p, fig: {
         ("", label): (0.0, 0.0) for label in ("true position x1", "true velocity x2", "estimate x̂1", "estimate x̂2")},
 }
+STATED.update({name: stated for module in CHAPTER_CASES for name, stated in getattr(module, "STATED", {}).items()})
 
 
 def _first_sample(fig, title_pattern: str, label: str) -> tuple[float, float]:

@@ -24,7 +24,7 @@ pytestmark = pytest.mark.skipif(is_extended(), reason="this project already hold
 def test_the_doc_has_an_explorer_an_exercise_and_a_chapter():
     files = [body.splitlines()[0] for lang, body in doc_blocks() if body.startswith("# file: ")]
     assert files == ["# file: coursekit/explorers/ch5.py", "# file: coursekit/exercises/ch5.py",
-                     "# file: tests/bad_input_ch5.py"]
+                     "# file: tests/cases_ch5.py"]
     text = DOC.read_text(encoding="utf-8")
     for public in ("from coursekit.explorers import Explorer", "from coursekit.exercises import"):
         assert public in text
@@ -32,7 +32,7 @@ def test_the_doc_has_an_explorer_an_exercise_and_a_chapter():
 
 
 #: the files of chapter 5, the only ones the doc may add or change (besides what builds write)
-CHAPTER_5 = {"coursekit/explorers/ch5.py", "coursekit/exercises/ch5.py", "tests/bad_input_ch5.py",
+CHAPTER_5 = {"coursekit/explorers/ch5.py", "coursekit/exercises/ch5.py", "tests/cases_ch5.py",
              "notebooks/05_lag.ipynb"}
 
 

@@ -1,4 +1,4 @@
-"""Bad-input cases of chapter 1's explorer functions (read by tests/bad_input_cases.py)."""
+"""Chapter 1's own test cases: the bad inputs of its explorer functions (read by tests/bad_input_cases.py)."""
 
 import numpy as np
 

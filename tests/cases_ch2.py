@@ -1,4 +1,4 @@
-"""Bad-input cases of chapter 2's explorer functions (read by tests/bad_input_cases.py)."""
+"""Chapter 2's own test cases: the bad inputs of its explorer functions (read by tests/bad_input_cases.py)."""
 
 import numpy as np
 
