@@ -2,7 +2,7 @@
 
 A block whose first line is ``# file: PATH`` is written to PATH; every other ``python`` block
 runs, in order, in one interpreter started at the copy's root. `tests/test_extending.py` checks
-the copy; CI runs the README's whole test command in one (``python tests/extending_doc.py DEST``).
+the copy; ``python tests/extending_doc.py DEST`` makes one to run the README's whole test command in.
 """
 
 from __future__ import annotations

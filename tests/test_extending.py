@@ -2,8 +2,8 @@
 explorer, an exercise and a fifth chapter, and the checks every chapter must pass pick the new
 chapter up there.
 
-The copy is made by `extending_doc.extend`; CI's extended run runs the README's whole test command
-in such a copy (``.ci/run``), where this module skips itself.
+The copy is made by `extending_doc.extend` (``python tests/extending_doc.py DEST`` makes one to run
+the README's whole test command in, where this module skips itself).
 """
 
 from __future__ import annotations
@@ -18,7 +18,7 @@ import pytest
 from extending_doc import BUILT, DOC, ROOT, doc_blocks, extend, is_extended, run_in
 
 pytestmark = pytest.mark.skipif(is_extended(), reason="this project already holds the doc's chapter 5 "
-                                "(the copy CI's extended run tests); the doc is checked on the original")
+                                "(a copy made by tests/extending_doc.py); the doc is checked on the original")
 
 
 def test_the_doc_has_an_explorer_an_exercise_and_a_chapter():
@@ -76,8 +76,9 @@ def test_the_new_chapter_is_found_by_the_course_tools(extended):
     ["tests/test_figure_style.py", "-k", "lag_explorer or 05_lag"],
 ], ids=["notebook and slides", "bad input", "explorer frames and layout", "colours and contrast"])
 def test_the_checks_every_chapter_must_pass_pass_for_the_new_chapter(extended, args):
-    """The checks the doc names, on chapter 5 (the slides without the browser: CI's extended run
-    runs the README's whole test command, browser tests included, on such a copy)."""
+    """The checks the doc names, on chapter 5 (the slides without the browser, which built and
+    opened every chapter's slides again: the README's whole command on a copy made by
+    tests/extending_doc.py runs them)."""
     result = run_in([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *args], extended, timeout=900)
     assert result.returncode == 0, result.stdout[-5000:]
     assert re.search(r"\b\d+ passed", result.stdout), result.stdout[-2000:]
