@@ -1,15 +1,10 @@
 """What an explorer shows in a notebook reopened after a save: its figure, not a widget error.
 
-JupyterLab and Notebook 7 save a widget's view in the notebook, not its state; reopened with a
-new kernel (or none), ipywidgets' renderer finds no model and shows "Error displaying widget:
-model not found" (or "Loading widget..."), never another type of the same output. Saving the
-widget state (ipywidgets' ``saveState`` setting) is not restored without a kernel in JupyterLab
-4 (jupyterlab/jupyterlab#15361) and writes metadata into every notebook saved. So an explorer
-shown in a kernel publishes, just before its widget, an HTML output: its figure for the settings
-it was shown with, the figure's text alternative, the readout and a line saying that running
-the cell makes it live. Its style sheet shows either that output or the widget: the fallback is
-hidden while the output after it holds a live explorer, and that output while it holds none.
-The static builds (website, slides) drop it (`is_fallback`): they show their own static explorer.
+A saved notebook keeps a widget's view, not its state, and ipywidgets' renderer then shows "model
+not found" and never another type of the same output (saving widget state does not help without
+a kernel: jupyterlab/jupyterlab#15361). So an explorer shown in a kernel first publishes an HTML
+output with its figure, text alternative and readout; its style sheet shows either it or the live
+widget after it. The static builds (website, slides) drop it (`is_fallback`).
 """
 
 from __future__ import annotations
@@ -39,15 +34,13 @@ def fallback_html(title: str, png: bytes, alt: str, readout: str) -> str:
             + "<p><i>The figure saved with the notebook: run this cell to move the controls.</i></p></div>")
 
 
-def publish_fallback(explorer) -> None:
-    """Publish the fallback of `explorer` as an output of the running cell (in a kernel only)."""
+def publish_fallback(explorer, png: bytes) -> None:
+    """Publish the fallback of `explorer`, its figure `png`, as an output of the running cell (in a kernel only)."""
     from IPython import get_ipython
-    shell = get_ipython()
-    if shell is None or getattr(shell, "kernel", None) is None:
-        return
     from IPython.display import publish_display_data
-    content = fallback_html(explorer.title, explorer.static_png(), explorer.alt, explorer.text)
-    publish_display_data({"text/html": content}, metadata={FALLBACK: True})
+    if getattr(get_ipython(), "kernel", None) is not None:
+        publish_display_data({"text/html": fallback_html(explorer.title, png, explorer.alt, explorer.text)},
+                             metadata={FALLBACK: True})
 
 
 def is_fallback(output) -> bool:
