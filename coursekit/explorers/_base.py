@@ -1,14 +1,11 @@
 """The machinery shared by every explorer: controls that redraw one figure as they move.
 
-An explorer is a set of controls and plain functions: ``compute(**params)``, pure numerics
-(unit-tested without a browser); ``draw(fig)``, which builds axes and empty artists once and
-returns handles; ``update(handles, result)``, which moves the artists' data and sets the
-limits (`rescale`, whose policy is the module `limits`); and optionally ``readout(result)``,
-the numbers worth reading, shown next to the controls. A `FrameRenderer` draws each frame,
-blitting while the axes stay (the frames of a drag are drawn inside `limits.moving`, and one
-frame follows once the controls rest); a `FigureView` shows it at the size and pixel ratio the browser reports. Callbacks run on the
-kernel's main thread (`HomeThread`). The display data also carry a static PNG, for pages
-without a kernel (GitHub, the website), and a fallback output comes before them (`_fallback`).
+An explorer is controls and plain functions: ``compute(**params)``, pure numerics; ``draw(fig)``,
+which builds axes and empty artists once and returns handles; ``update(handles, result)``, which
+moves the artists' data and sets the limits (`limits.rescale`); optionally ``readout(result)``, the
+numbers shown next to the controls. A `FrameRenderer` draws each frame (blitting while the axes
+stay), a `FigureView` shows it; callbacks run on the kernel's main thread (`HomeThread`). The
+display data carry a static PNG for pages without a kernel, after a fallback output (`_fallback`).
 """
 
 from __future__ import annotations
@@ -17,7 +14,6 @@ import base64
 import functools
 import html
 from typing import Any, Callable
-
 
 from .._validation import as_scalar
 from ..describe import describe_figure
@@ -288,9 +284,10 @@ class Explorer:
 
     def _repr_mimebundle_(self, include=None, exclude=None):
         bundle = self.widget._repr_mimebundle_(include=include, exclude=exclude)
-        bundle["image/png"] = base64.b64encode(self.static_png()).decode("ascii")
+        png = self.static_png()
+        bundle["image/png"] = base64.b64encode(png).decode("ascii")
         bundle["text/plain"] = repr(self)
-        publish_fallback(self)   # shown before the widget where it cannot be (a reopened notebook)
+        publish_fallback(self, png)   # shown before the widget where it cannot be (a reopened notebook)
         return bundle
 
     def __repr__(self) -> str:   # the text a page without a kernel shows for the figure: its alt and data

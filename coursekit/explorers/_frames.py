@@ -1,11 +1,9 @@
 """Frames of an explorer figure: a full draw when the axes change, blitting otherwise.
 
-Most of a draw goes into what a slider does not move: axes, ticks, labels, layout. The artists
-an update moves (matplotlib marks them *stale*) are made *animated*, so a full draw leaves them
-out; that draw is kept as the background, and each frame restores it and draws on top the moving
-artists and every artist drawn after them (by zorder) that can meet them (a legend on the data,
-not a title), so a blitted frame shows what a full draw would. A full draw happens again only
-when the background changes: limits, scales, labels, titles, size, or a new moving artist.
+The artists an update moves (matplotlib marks them *stale*) are made *animated*; a full draw
+without them is kept as the background, and a frame restores it and draws the moving artists and
+every later artist that can meet them (a legend on the data), so it shows what a full draw would.
+A full draw happens again only when the background changes (limits, labels, size, a new artist).
 """
 
 from __future__ import annotations

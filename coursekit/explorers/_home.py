@@ -1,10 +1,9 @@
 """Widget callbacks run on the kernel's main thread, one at a time.
 
-A front end may hand widget messages to a second thread of the kernel (a *subshell*: JupyterLab
-4.6 with ipykernel 7 does so by default), while a cell or another explorer draws on the main
-thread; matplotlib is not safe for that (garbled frames, "failed to load glyph"). `HomeThread`
-remembers the thread and event loop that built the widget and runs each callback there: at once
-when it arrives there, else queued on the loop, between cells. Without a loop, where it arrives.
+A front end may hand widget messages to a second kernel thread (a *subshell*: JupyterLab 4.6
+with ipykernel 7), while the main thread draws; matplotlib is not safe for that. `HomeThread`
+runs each callback on the thread and event loop that built the widget: at once when it arrives
+there, else queued on the loop; without a loop, where it arrives.
 """
 
 from __future__ import annotations

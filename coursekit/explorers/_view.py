@@ -1,13 +1,10 @@
 """The browser side of an explorer: its figure at the screen's own pixel size, and its styling.
 
-`FigureView` is a small anywidget (no build step) whose script and style sheet are the files
-`VIEW_JS` (``view.js``) and `VIEW_CSS` (``view.css``) beside this module, shipped as package
-data. It shows the kernel's PNG as an ``<img>`` at the PNG's pixel size over the device pixel
-ratio (never scaled), and reports the pixel ratio and the room the figure has when shown and
-when that room changes; it asks for nothing else, so while nobody touches a control the kernel
-does no work. The image carries the text alternative; a polite live region announces it once a
-control has rested. The explorer's controls keep the keys pressed on them from the notebook's
-shortcuts.
+`FigureView` is a small anywidget whose script and style sheet are the package-data files
+`VIEW_JS` and `VIEW_CSS`. It shows the kernel's PNG at its pixel size over the device pixel
+ratio and reports the ratio and the room the figure has when shown and when it changes, so an
+untouched explorer costs the kernel nothing. The image carries the text alternative, announced
+by a polite live region once a control rests; keys on the controls never reach the notebook.
 """
 
 from __future__ import annotations

@@ -1,19 +1,13 @@
-"""The explorers' limit policy: `rescale` fits an axes' view to its data, and `moving` says
-that a hand moves a control.
+"""The explorers' limit policy: `rescale` fits an axes' view to its data; `moving` says a hand
+moves a control.
 
-At rest (outside `moving`) the limits depend on the data alone, never on the figures drawn
-before: the figure of a setting is the same after a drag, after key steps, in a fresh
-explorer and in the website's frames (`coursekit.tools.static_explorers`). They are the data
-padded so that they fill `fill` of the view, each end then moved out to a multiple of a round
-step (1, 2 or 5 times a power of ten) no larger than that padding: a slider stepped on changes
-the limits only when the data cross such a multiple, every few steps (each change of the limits
-is a full draw of the figure), and the data fill between ``fill / (2 - fill)`` and `fill` of
-the view (2/3 to 0.8 by default; exactly with ``fill=1``); a vertical axis' limits then move out
-by `Y_EDGE` of their span, so that no tick label sits on the frame's corner.
-
-While a control moves (a drag: moves less than `SETTLE_S` apart; `Explorer` draws those frames
-inside `moving`) the limits only grow, when the data leave them, to leave the data
-`MOVING_FILL` of them; the frame drawn once the control rests fits them as above.
+At rest the limits depend on the data alone, so a setting's figure is the same after a drag,
+after key steps, fresh, and in the website's frames (`coursekit.tools.static_explorers`): the
+data padded to fill `fill` of the view, each end moved out to a multiple of a round step (1, 2
+or 5 times a power of ten) no larger than the padding, so that stepping a slider redraws the
+limits only every few steps; a vertical axis then gains `Y_EDGE` of its span either way (no tick
+label on the frame's corner). While a control moves (moves less than `SETTLE_S` apart, drawn
+inside `moving`) the limits only grow, leaving the data `MOVING_FILL` of them.
 """
 
 from __future__ import annotations
@@ -32,9 +26,7 @@ __all__ = ["rescale", "moving", "is_moving", "SETTLE_S", "MOVING_FILL", "Y_EDGE"
 SETTLE_S = 0.3
 #: while a control moves, limits that grow leave the data this fraction of them
 MOVING_FILL = 0.6
-
-#: at rest a vertical axis' rounded limits move out by this part of their span: no tick on the
-#: frame's bottom corner, where the horizontal axis' first label (a time axis' 0) stands
+#: at rest a vertical axis' limits move out by this part of their span (no tick on the corner)
 Y_EDGE = 0.05
 
 _MOVING = contextvars.ContextVar("moving", default=False)
@@ -56,17 +48,12 @@ def is_moving() -> bool:
 
 
 def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, relim: bool = True) -> None:
-    """Fit the view of each of `axes` to the data its artists hold (call it in an update), by
-    the module's policy: at rest a function of the data alone, rounded out to a round step;
-    while a control moves (`moving`), grown only.
-
-    The limits never go past an artist's sticky edges (matplotlib's ``Artist.sticky_edges``: a
-    time axis that starts at 0 gets ``line.sticky_edges.x.append(0)``). `axis` is ``"y"``,
-    ``"x"`` or ``"both"``; a log axis is fitted in decades. With `min_span`, the view spans at
-    least that much, centred on the data: a response that stays at a constant is drawn flat,
-    not its rounding noise magnified. ``fill=1`` fits the data exactly (a time axis). With
-    ``relim=False`` the data are the axes' data limits as the update set them
-    (``ax.update_datalim``), not measured from its artists.
+    """Fit the view of each of `axes` to its artists' data (call it in an update), by the module's
+    policy. `axis` is ``"y"``, ``"x"`` or ``"both"``; a log axis is fitted in decades; the limits
+    never pass an artist's ``sticky_edges`` (a time axis from 0). With `min_span` the view spans at
+    least that much, centred (a constant is drawn flat, not its rounding noise magnified);
+    ``fill=1`` fits the data exactly; with ``relim=False`` the data are the data limits the update
+    set (``ax.update_datalim``).
     """
     if axis not in ("x", "y", "both"):
         raise ValueError(f"axis must be 'x', 'y' or 'both': received {axis!r}.")
