@@ -8,7 +8,8 @@
   chapters the session executed already replayed rather than executed again
   (`executed_chapters.replaying`; tests/test_slides.py, tests/test_build_structure.py).
 
-Each is built when a test first asks for it; the tests skip themselves when a tool is missing.
+Each is built once per run, when a test first asks for it, however many xdist workers ask; the
+tests skip themselves when a tool is missing.
 """
 
 from __future__ import annotations
@@ -18,37 +19,36 @@ from pathlib import Path
 
 from coursekit.__main__ import main
 from executed_chapters import ExecutedChapters, replaying
+from run_once import once, shared_folder
 
 __all__ = ["CourseBuilds"]
 
 
 class CourseBuilds:
-    """Lazily built website and slides of the course, in folders of the session's temp area."""
+    """The website and the slides of the course, each built once per run, when a test first asks
+    for it, into the run's shared folder (tests/run_once.py)."""
 
     def __init__(self, tmp_path_factory, executed_chapters: ExecutedChapters):
-        self._tmp = tmp_path_factory
+        self._folder = shared_folder(tmp_path_factory) / "builds"
         self._executed = executed_chapters
-        self._site: dict[str, Path] | None = None
-        self._slides: Path | None = None
 
     def site(self) -> dict[str, Path]:
         """``{"instructor": folder, "student": folder}``: both editions, siblings of one folder."""
-        if self._site is None:
-            base = self._tmp.mktemp("site")
-            site = {"instructor": base / "instructor", "student": base / "student"}
-            start = time.monotonic()
-            assert main(["site", "--out", str(site["instructor"]), "--student-out", str(site["student"])]) == 0
-            print(f"\nboth editions of the site built in {time.monotonic() - start:.0f} s")
-            self._site = site
-        return self._site
+        base = once(self._folder / "site", _build_site)
+        return {"instructor": base / "instructor", "student": base / "student"}
 
     def slides(self) -> Path:
         """The folder of the whole course's slides."""
-        if self._slides is None:
-            out = self._tmp.mktemp("slides") / "slides"
-            start = time.monotonic()
-            with replaying(self._executed):
-                assert main(["slides", "--out", str(out)]) == 0
-            print(f"\nslides of the course built in {time.monotonic() - start:.0f} s")
-            self._slides = out
-        return self._slides
+        return once(self._folder / "slides", self._build_slides) / "slides"
+
+    def _build_slides(self, out: Path) -> None:
+        start = time.monotonic()
+        with replaying(self._executed):
+            assert main(["slides", "--out", str(out / "slides")]) == 0
+        print(f"\nslides of the course built in {time.monotonic() - start:.0f} s")
+
+
+def _build_site(out: Path) -> None:
+    start = time.monotonic()
+    assert main(["site", "--out", str(out / "instructor"), "--student-out", str(out / "student")]) == 0
+    print(f"\nboth editions of the site built in {time.monotonic() - start:.0f} s")

@@ -11,8 +11,9 @@ outputs (the session fixture ``executed_chapters`` of tests/conftest.py, an `Exe
   (tests/test_release.py).
 
 nbval executes every notebook as its own test besides; the website's build executes its own, since
-it draws every figure for its page's column. Chapters asked for together run side by side, one
-kernel per core at a time, in kernels of this interpreter.
+it draws every figure for its page's column. Each is executed once per run, in a kernel of this
+interpreter, by the first xdist worker that asks, and written to the run's shared folder
+(tests/run_once.py), which the other workers read.
 """
 
 from __future__ import annotations
@@ -25,10 +26,11 @@ from pathlib import Path
 import nbformat
 import pytest
 
-from coursekit.tools.notebooks import default_notebook_dir, execute_all, read_notebook
+from coursekit.tools.notebooks import default_notebook_dir, execute_all, read_notebook, write_notebook
 from coursekit.tools.slideshow import DESCRIBE_FIGURES
 from kernels import this_python_kernel
 from notebook_figures import PRELUDE as FIGURE_CHECKS, REPORT
+from run_once import made, once, shared_folder
 
 __all__ = ["PRELUDE", "Executed", "ExecutedChapters", "replay_into", "replaying"]
 
@@ -43,63 +45,57 @@ class Executed:
 
 
 class ExecutedChapters:
-    """The chapters this session executed. `instructor(names)` and `student()` execute what was
-    not executed yet (side by side) and hand out the executed notebooks; `has_instructor(name)`
-    says whether that chapter's is there, without executing it. A chapter that failed fails every
-    test that asks for it, with the message, and is not executed again."""
+    """The chapters this run executed, each once however many xdist workers ask (tests/run_once.py):
+    `instructor(name)` and `student()` execute what no worker executed yet and hand out the
+    executed notebooks; `has_instructor(name)` says whether that chapter's is there, without
+    executing it. A chapter that failed fails every test that asks for it, with the message."""
 
     def __init__(self, tmp_path_factory):
-        self._tmp = tmp_path_factory
-        self._done = {}     # ("instructor", file name) or ("student", "") -> result or failure message
+        self._folder = shared_folder(tmp_path_factory) / "executed"
+        self._read = {}     # ("instructor", file name) or ("student", "") -> what was read
 
-    def instructor(self, names: list[str]) -> list:
-        """The executed notebooks of the instructor edition's files called `names`."""
-        missing = [name for name in names if ("instructor", name) not in self._done]
-        if missing:
-            self._run([("instructor", name) for name in missing], lambda: _execute_instructor(missing))
-        return [self._ready(("instructor", name)) for name in names]
+    def instructor(self, name: str):
+        """The executed notebook of the instructor edition's file called `name`."""
+        key = ("instructor", name)
+        if key not in self._read:
+            folder = once(self._folder / "instructor" / name, lambda out: _execute_instructor(name, out))
+            self._read[key] = read_notebook(folder / name)
+        return self._read[key]
 
     def has_instructor(self, name: str) -> bool:
-        return not isinstance(self._done.get(("instructor", name), ""), str)
+        return ("instructor", name) in self._read or made(self._folder / "instructor" / name)
 
     def student(self) -> Executed:
-        if ("student", "") not in self._done:
-            self._run([("student", "")], lambda: [_execute_student(self._tmp.mktemp("student") / "edition")])
-        return self._ready(("student", ""))
-
-    def _run(self, keys: list, run) -> None:
-        try:
-            self._done.update(zip(keys, run()))
-        except Exception as error:
-            message = f"executing {', '.join(k[1] or k[0] for k in keys)} failed: {type(error).__name__}: "
-            self._done.update(dict.fromkeys(keys, message + str(error)[:2000]))
-            raise
-
-    def _ready(self, key):
-        if isinstance(self._done[key], str):
-            pytest.fail(self._done[key])
-        return self._done[key]
+        if ("student", "") not in self._read:
+            folder = once(self._folder / "student", _execute_student)
+            paths = sorted((folder / "edition").glob("*.ipynb"))
+            executed = [read_notebook(folder / "executed" / path.name) for path in paths]
+            self._read[("student", "")] = Executed(paths, executed)
+        return self._read[("student", "")]
 
 
-def _execute_instructor(names: list[str]) -> list:
-    """The instructor edition's chapters called `names`, with their slide types, executed after
-    the slides' first cell and the figure checks' (`PRELUDE`)."""
+def _execute_instructor(name: str, out: Path) -> None:
+    """The instructor edition's chapter called `name`, with its slide types, executed after the
+    slides' first cell and the figure checks' (`PRELUDE`), written into the folder `out`."""
     from coursekit.tools.slides import with_slide_metadata
-    paths = [default_notebook_dir() / name for name in names]
-    notebooks = [with_slide_metadata(read_notebook(path)) for path in paths]
-    for nb in notebooks:
-        nb.cells.insert(0, nbformat.v4.new_code_cell(PRELUDE))
-    _execute(notebooks, paths)
-    return notebooks
+    path = default_notebook_dir() / name
+    nb = with_slide_metadata(read_notebook(path))
+    nb.cells.insert(0, nbformat.v4.new_code_cell(PRELUDE))
+    _execute([nb], [path])
+    out.mkdir()
+    write_notebook(nb, out / name)
 
 
-def _execute_student(folder: Path) -> Executed:
-    """The student edition as ``python -m coursekit release`` writes it into `folder`, executed."""
+def _execute_student(folder: Path) -> None:
+    """The student edition as ``python -m coursekit release`` writes it into ``folder/edition``,
+    executed there; the executed copies written into ``folder/executed``."""
     from coursekit.tools.release import build_release
-    paths = build_release(folder)
+    paths = build_release(folder / "edition")
     notebooks = [read_notebook(path) for path in paths]
     _execute(notebooks, paths)
-    return Executed(paths, notebooks)
+    (folder / "executed").mkdir()
+    for nb, path in zip(notebooks, paths):
+        write_notebook(nb, folder / "executed" / path.name)
 
 
 def _execute(notebooks: list, paths: list[Path]) -> None:
@@ -137,7 +133,7 @@ def replaying(executed_chapters: ExecutedChapters):
         rest = []
         for nb, path in zip(nbs, sources):
             if executed_chapters.has_instructor(path.name):
-                replay_into(nb, executed_chapters.instructor([path.name])[0], drop=(REPORT,))
+                replay_into(nb, executed_chapters.instructor(path.name), drop=(REPORT,))
             else:
                 rest.append((nb, path))
         if rest:

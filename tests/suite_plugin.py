@@ -8,6 +8,12 @@
   (parametrized over them), which move every slider over its range or drag it, in several styles;
 * ``slow`` (set here): any of the three. ``python -m pytest -m "not slow"`` is the contributors'
   fast loop.
+
+The run is spread over the machine's cores by pytest-xdist (``-n logical --dist loadfile`` in
+pyproject.toml): each test module goes to one worker as a whole (nbval's cells share their
+notebook's kernel, module fixtures are made once). The modules are handed out longest first: those
+that read the run's executed chapters and builds (`SESSION_FIXTURES`, made once per run:
+tests/run_once.py), then those with a slow test, then the rest, each in its own order.
 """
 
 from __future__ import annotations
@@ -16,8 +22,8 @@ import pytest
 
 import lab_harness
 
-__all__ = ["NOTEBOOK_TESTS", "NOTEBOOK_FIXTURES", "SWEEP_MODULES", "browser_skip_line", "pytest_collection_modifyitems",
-           "pytest_collection_finish", "pytest_terminal_summary"]
+__all__ = ["NOTEBOOK_TESTS", "NOTEBOOK_FIXTURES", "SWEEP_MODULES", "SESSION_FIXTURES", "browser_skip_line",
+           "pytest_collection_modifyitems", "pytest_collection_finish", "pytest_terminal_summary"]
 
 #: the tests that execute notebooks besides nbval's, as "module::test" (every parametrization)
 NOTEBOOK_TESTS = {
@@ -32,7 +38,8 @@ NOTEBOOK_FIXTURES = {"executed_chapters", "course_builds", "release", "graded", 
 #: the modules whose tests parametrized over the course's explorers are sweeps
 SWEEP_MODULES = {"test_explorer_frames.py", "test_figure_layout.py", "test_figure_style.py"}
 
-_BROWSER_SKIP = pytest.StashKey[tuple]()    # (reason, number of browser tests skipped)
+#: the session fixtures whose work is made once per run: their modules are handed out first
+SESSION_FIXTURES = {"executed_chapters", "course_builds"}
 
 
 def _executes_notebooks(item) -> bool:
@@ -52,9 +59,20 @@ def _sweeps(item, explorers: list) -> bool:
                for value in item.callspec.params.values())
 
 
+def _rank(items) -> dict:
+    """{module path: 0 when a test of it reads a session fixture, 1 when one is slow, else 2}."""
+    rank: dict = {}
+    for item in items:
+        mine = 0 if SESSION_FIXTURES & set(getattr(item, "fixturenames", ())) else \
+            1 if item.get_closest_marker("slow") else 2
+        rank[item.path] = min(rank.get(item.path, 2), mine)
+    return rank
+
+
 @pytest.hookimpl(tryfirst=True)      # before -m deselects by these markers
 def pytest_collection_modifyitems(config, items):
-    """Mark the notebook tests, the sweeps and all slow tests."""
+    """Mark the notebook tests, the sweeps and all slow tests; put the modules in the order xdist
+    hands them out (see the module's doc)."""
     from coursekit.tools.chapters import explorer_factories
     explorers = list(explorer_factories().values())
     for item in items:
@@ -64,14 +82,15 @@ def pytest_collection_modifyitems(config, items):
             item.add_marker(pytest.mark.sweeps)
         if any(item.get_closest_marker(name) for name in ("notebooks", "sweeps", "browser")):
             item.add_marker(pytest.mark.slow)
+    rank = _rank(items)
+    items.sort(key=lambda item: rank[item.path])    # a stable sort: each module keeps its order
 
 
 def pytest_collection_finish(session):
-    """Skip the browser tests that are to run, saying why once, when no browser is here."""
+    """Skip the browser tests that are to run when no browser is here (in each xdist worker)."""
     browser = [item for item in session.items if item.get_closest_marker("browser")]
     reason = lab_harness.missing_reason() if browser else None
     if reason:
-        session.config.stash[_BROWSER_SKIP] = (reason, len(browser))
         for item in browser:
             item.add_marker(pytest.mark.skip(reason=reason))
 
@@ -82,5 +101,9 @@ def browser_skip_line(reason: str, count: int) -> str:
 
 
 def pytest_terminal_summary(terminalreporter, exitstatus, config):
-    if _BROWSER_SKIP in config.stash:
-        terminalreporter.write_line(browser_skip_line(*config.stash[_BROWSER_SKIP]), yellow=True)
+    """Say once why the browser tests were skipped (read from the reports: the workers skipped them)."""
+    skipped = [report for report in terminalreporter.stats.get("skipped", []) if "browser" in report.keywords]
+    reason = lab_harness.missing_reason() if skipped else None
+    count = sum(reason in str(report.longrepr) for report in skipped) if reason else 0
+    if count:
+        terminalreporter.write_line(browser_skip_line(reason, count), yellow=True)

@@ -151,7 +151,7 @@ def test_explorer_figure_is_readable_by_everyone_over_its_slider_range(name):
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_every_figure_a_notebook_shows_is_readable_by_everyone(path, executed_chapters):
-    reports = figure_reports(executed_chapters.instructor([path.name])[0])
+    reports = figure_reports(executed_chapters.instructor(path.name))
     assert reports, "the notebook shows no figure: every chapter has explorers and figures"
     missing = [r["cell"] for r in reports if r["report"] is None]
     assert not missing, f"images of cells {missing} were not checked (not a figure or explorer?)"

@@ -22,7 +22,7 @@ NUMPY_REPR = re.compile(r"\bnp\.(?:float|int|uint|complex|bool|str_|True_|False_
 
 @pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_no_output_shows_a_numpy_scalar_repr(path, executed_chapters):
-    executed = executed_chapters.instructor([path.name])[0]
+    executed = executed_chapters.instructor(path.name)
     found = [f"cell {index}: {line.strip()}" for index, text in text_outputs(executed)
              for line in text.splitlines() if NUMPY_REPR.search(line)]
     assert not found, "\n".join(found)

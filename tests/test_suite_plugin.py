@@ -61,6 +61,73 @@ def test_without_chromium_the_browser_tests_skip_with_one_line(pytester, monkeyp
     assert [line for line in one.outlines if "browser tests skipped" in line][0].startswith("1 browser tests")
 
 
+def _conftest_for_workers(pytester, source: str = "") -> None:
+    """A conftest that loads suite_plugin from the suite's folder, which pytest-xdist's workers do
+    not have on their path (they start from the path this process started with), then `source`."""
+    pytester.makeconftest(f"import sys\nsys.path.insert(0, {str(Path(__file__).parent)!r})\n"
+                          f"pytest_plugins = ['suite_plugin']\n{source}")
+
+
+def test_spread_over_workers_the_skip_line_is_still_written_once(pytester):
+    # the workers skip the tests, the controller writes the line (from the reports)
+    _conftest_for_workers(pytester, "import lab_harness\nlab_harness.chromium_path = lambda: None\n")
+    pytester.makeini("[pytest]\nmarkers =\n    browser: b\n    notebooks: n\n")
+    pytester.makepyfile(test_ck_lab=_BROWSER_TESTS.format(name="lab"), test_ck_site=_BROWSER_TESTS.format(name="site"))
+    result = pytester.runpytest("-n", "2", "--dist", "loadgroup")
+    result.assert_outcomes(skipped=4)
+    assert len([line for line in result.outlines if line.startswith("4 browser tests skipped: Chromium")]) == 1
+
+
+_SESSION_CONFTEST = """
+import os, pytest
+from run_once import once, shared_folder
+
+def _build(folder):
+    with open(os.environ["CK_MADE"], "a") as made:
+        made.write(os.environ.get("PYTEST_XDIST_WORKER", "main") + "\\n")
+    folder.mkdir()
+
+@pytest.fixture(scope="session")
+def executed_chapters(tmp_path_factory):
+    return once(shared_folder(tmp_path_factory) / "chapters", _build)
+"""
+
+_MODULE = """
+import os
+
+def record(what):
+    with open(os.environ["CK_RAN"], "a") as ran:
+        ran.write(f"{what} {os.environ.get('PYTEST_XDIST_WORKER', 'main')}\\n")
+""" + "".join(f"""
+def test_cell_{i}():
+    record("NAME")
+
+def test_reads_{i}(READS):
+    record("NAME")
+""" for i in range(3))
+
+
+def test_work_for_the_run_is_made_once_and_each_module_stays_on_one_worker(pytester, monkeypatch, tmp_path):
+    monkeypatch.setenv("CK_MADE", str(tmp_path / "made"))
+    monkeypatch.setenv("CK_RAN", str(tmp_path / "ran"))
+    _conftest_for_workers(pytester, _SESSION_CONFTEST)
+    pytester.makeini("[pytest]\nmarkers =\n    browser: b\n    notebooks: n\n    sweeps: s\n    slow: l\n")
+    modules = {f"test_ck_{name}": _MODULE.replace("NAME", name).replace("READS", reads)
+               for name, reads in [("a", "tmp_path"), ("b", "executed_chapters"), ("c", "tmp_path"),
+                                   ("d", "executed_chapters")]}
+    pytester.makepyfile(**modules)
+    result = pytester.runpytest("-n", "2", "--dist", "loadfile", "--no-loadscope-reorder")
+    result.assert_outcomes(passed=24)
+    assert len((tmp_path / "made").read_text().split()) == 1, "made by both workers"
+    ran = [line.split() for line in (tmp_path / "ran").read_text().splitlines()]
+    for name in "abcd":
+        assert len({worker for module, worker in ran if module == name}) == 1, (name, ran)
+    # the modules that read the run's work come first, each in its own order
+    order = pytester.runpytest("-n", "0", "--collect-only", "-q").outlines
+    assert [line.split("::")[0] for line in order if "::" in line][::6] == \
+        ["test_ck_b.py", "test_ck_d.py", "test_ck_a.py", "test_ck_c.py"], order
+
+
 def test_with_everything_there_no_skip_line_is_written(pytester, monkeypatch):
     monkeypatch.setattr(lab_harness, "missing_reason", lambda: None)
     pytester.makeini("[pytest]\nmarkers =\n    browser: b\n    notebooks: n\n")

@@ -1,0 +1,54 @@
+"""Work done once per test run, however many pytest-xdist workers ask for it.
+
+The run is spread over the cores (``-n logical --dist loadfile``, pyproject.toml); each worker is a
+process with its own session fixtures. The session's executions and builds (tests/executed_chapters.py,
+tests/course_builds.py) are made by the first worker that asks, into a folder all workers share,
+under a file lock (the ``filelock`` package); a worker that asks later waits for the lock and
+reads what the first one wrote, as files. A failed build is not tried again: every worker that
+asks for it fails with its message.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import Callable
+
+import pytest
+from filelock import FileLock
+
+__all__ = ["shared_folder", "once", "made"]
+
+_DONE, _FAILED = ".done", ".failed"
+
+
+def shared_folder(tmp_path_factory) -> Path:
+    """The temp folder every worker of this run shares: under xdist (which names the worker in
+    ``PYTEST_XDIST_WORKER``) the parent of the workers' own, else the session's."""
+    base = tmp_path_factory.getbasetemp()
+    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+
+
+def made(folder: Path) -> bool:
+    """Whether a worker of this run has made `folder` with `once` (without waiting for one that is making it)."""
+    return Path(str(folder) + _DONE).exists()
+
+
+def once(folder: Path, build: Callable[[Path], None]) -> Path:
+    """`folder`, made by ``build(folder)`` unless a worker of this run made it already (or is
+    making it: then this one waits). Fails the asking test, with the first attempt's message,
+    when that build raised."""
+    folder.parent.mkdir(parents=True, exist_ok=True)
+    with FileLock(str(folder) + ".lock"):
+        done, failed = Path(str(folder) + _DONE), Path(str(folder) + _FAILED)
+        if failed.exists():
+            pytest.fail(failed.read_text(encoding="utf-8"))
+        if not done.exists():
+            try:
+                build(folder)
+            except Exception as error:
+                failed.write_text(f"building {folder.name} failed: {type(error).__name__}: {str(error)[:2000]}",
+                                  encoding="utf-8")
+                raise
+            done.touch()
+    return folder
