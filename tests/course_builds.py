@@ -4,9 +4,10 @@
 * `site`: both editions of the website from one execution of the chapters, as
   ``python -m coursekit site --out DIR --student-out DIR`` builds them (tests/test_site_browser.py
   opens them in Chromium; tests/test_build_structure.py compares what they show with its record);
-* `slides`: the slides of the whole course, as ``python -m coursekit slides`` builds them, the
-  chapters the session executed already replayed rather than executed again
-  (`executed_chapters.replaying`; tests/test_slides.py, tests/test_build_structure.py).
+* `slides`: the slides of the whole course, built by `build_slides` (what ``python -m coursekit
+  slides`` calls), the chapters the session executed already replayed rather than executed again
+  (its `execute` argument, `executed_chapters.replaying`; tests/test_slides.py,
+  tests/test_build_structure.py).
 
 Each is built when a test first asks for it; the tests skip themselves when a tool is missing.
 """
@@ -17,6 +18,7 @@ import time
 from pathlib import Path
 
 from coursekit.__main__ import main
+from coursekit.tools.slideshow import build_slides
 from executed_chapters import ExecutedChapters, replaying
 
 __all__ = ["CourseBuilds"]
@@ -47,8 +49,7 @@ class CourseBuilds:
         if self._slides is None:
             out = self._tmp.mktemp("slides") / "slides"
             start = time.monotonic()
-            with replaying(self._executed):
-                assert main(["slides", "--out", str(out)]) == 0
+            build_slides(out, verbose=True, execute=replaying(self._executed))
             print(f"\nslides of the course built in {time.monotonic() - start:.0f} s")
             self._slides = out
         return self._slides
