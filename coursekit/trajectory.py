@@ -291,21 +291,13 @@ def poly_trajectory(T, start, end) -> PolyTrajectory:
     ``start = [y(0), y'(0), ..., y^(r-1)(0)]`` and likewise `end` at T give
     the unique polynomial of degree 2r - 1 (r = 2 is the cubic (2.33)).
 
-    Returns a `PolyTrajectory` ``traj`` with ``traj(t, k=0)`` the k-th
-    derivative. Instead of solving (2.37) in powers of t (hopeless for long
-    horizons or many conditions: the matrix holds T, T^2, ..., T^(2r-1)),
-    the polynomial is written in closed form in the normalized time
-    tau = t / T with a two-point Hermite basis (see `PolyTrajectory`).
-
-    Guarantees, for r up to 20 and any T whose powers T^k (k < 2r) stay in
-    double range: each boundary value and derivative is met to a few units in
-    the last place of its own value, and every derivative on [0, T] is within
-    about 50 eps of that derivative's largest value there. A T for which a
-    derivative on [0, T] leaves the float range (inf or NaN) raises a
-    ValueError naming T. After building,
-    the 2r boundary conditions are evaluated; a miss of more than
-    32 eps of the value (possible only when y^(k) T^k over- or underflows)
-    gives an `AccuracyWarning` saying which derivative, at which end, by how much.
+    Returns a `PolyTrajectory` ``traj`` with ``traj(t, k=0)`` the k-th derivative, written in
+    closed form in tau = t / T rather than by solving (2.37) in powers of t (a matrix of T, ...,
+    T^(2r-1): hopeless for long horizons or many conditions); its accuracy is `PolyTrajectory`'s
+    for any T whose powers T^k (k < 2r) stay in double range. A T for which a derivative on
+    [0, T] leaves the float range raises a ValueError naming T; a boundary condition missed by
+    more than 32 eps of its value (possible only when y^(k) T^k over- or underflows) gives an
+    `AccuracyWarning` saying which derivative, at which end, by how much.
     """
     T = as_scalar(T, "T", positive=True)
     start = as_vector(start, "start")
