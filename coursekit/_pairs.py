@@ -69,12 +69,8 @@ __all__ = ["as_pair", "as_obs_pair", "ctrb_unchecked", "Staircase", "unit_free_s
 
 
 _EPS = np.finfo(float).eps
-
-
 # a decision whose margin (coupling / tolerance, or its inverse) is below this is called marginal
 _MARGINAL = 100.0
-
-
 # the tolerance grows with 1 / (smallest coupling so far), up to this factor (module docstring)
 _AMPLIFICATION_CAP = 1e3
 

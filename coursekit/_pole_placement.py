@@ -38,8 +38,6 @@ ROUNDING = 1e-12
 # several inputs is refused before any work (it took minutes at n = 200, for poles that no
 # double-precision gain places anyway).
 _ROBUST_MAX_STATES = 40
-
-
 _MULTI_INPUT_MAX_STATES = 100
 
 

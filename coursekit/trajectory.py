@@ -535,15 +535,11 @@ def open_loop_control(A, B, x0, xT, T, *, smooth: int = 0) -> OpenLoopPlan:
     3. plan y_d = z1 as the polynomial of degree 2n - 1 with
        y_d^(k)(0) = z0[k], y_d^(k)(T) = zT[k] (2.31)-(2.38);
     4. apply the feedforward u_d (2.25) with the CCF's a and b = 1;
-    5. check the plan: its own x(0) = T^-1 z(0) and x(T), and the end state of
-       the plant driven by u_d (x' = A x + B u_d solved exactly, see
-       `_landing`), must meet x0 and xT to 1e-6 of max(|x0|, |xT|); otherwise
-       an `AccuracyWarning` says which one misses, by how much, how far the
-       plan swings on the way and what to try. The trajectory itself meets
-       its boundary conditions to rounding (`poly_trajectory`), so a miss comes
-       from the plant: a plan whose states pass through values ~1e9 times the
-       task's size (high n, a badly scaled model) cannot land in double
-       precision.
+    5. check the plan (`_check_plan`): its own x(0) and x(T), and the end state of the plant
+       driven by u_d (solved exactly, `_landing`), must meet x0 and xT to 1e-6 of
+       max(|x0|, |xT|), else an `AccuracyWarning` says which misses, by how much and what to
+       try. The trajectory meets its boundary conditions to rounding, so a miss comes from
+       the plant: states passing through ~1e9 times the task's size cannot land in doubles.
 
     ``smooth = s > 0`` adds s more boundary conditions, y_d^(n)..y_d^(n+s-1)
     = 0 at both ends (degree 2(n + s) - 1): then u_d starts and ends at the
