@@ -26,8 +26,6 @@ def _central(g: Callable, z: np.ndarray, h: np.ndarray, k: int) -> np.ndarray:
 
 
 _EPS = float(np.finfo(float).eps)
-
-
 _CBRT_EPS = float(np.cbrt(_EPS))
 
 
@@ -73,14 +71,8 @@ def difference_quotients(G: np.ndarray, h: np.ndarray) -> np.ndarray:
 # with the first: large steps can fake convergence on oscillating functions (for sin, the
 # quotients at h = 1024, 2048, 4096 differ by factors cos(h) that happen to be near 1).
 _LADDER = 30
-
-
 _TABLEAU = 6
-
-
 _ABSOLUTE_TOP = 0.25
-
-
 _RELATIVE = 16.0
 
 
@@ -162,8 +154,6 @@ def _ridders_column(D: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, float
 # point's scale, its golden-ratio fraction, and 2^-10 of it) when their quotients agree and the
 # second differences vanish to _AFFINE_RTOL of the column's size, plus their rounding.
 _AFFINE_RTOL = 1e-12
-
-
 _AFFINE_STEPS = (1.0, _OTHER, 2.0 ** -10)
 
 

@@ -64,17 +64,13 @@ import numpy as np
 from ._validation import as_matrix, as_square, require_columns, warn_accuracy
 from .diagnostics import NotControllableError
 
-__all__ = ["as_pair", "as_obs_pair", "ctrb_unchecked", "numerical_rank", "Staircase", "unit_free_staircase",
+__all__ = ["as_pair", "as_obs_pair", "ctrb_unchecked", "Staircase", "unit_free_staircase",
            "check_tol", "marginal_note", "balancing", "require_controllable", "canonical_transform"]
 
 
 _EPS = np.finfo(float).eps
-
-
 # a decision whose margin (coupling / tolerance, or its inverse) is below this is called marginal
 _MARGINAL = 100.0
-
-
 # the tolerance grows with 1 / (smallest coupling so far), up to this factor (module docstring)
 _AMPLIFICATION_CAP = 1e3
 
@@ -95,14 +91,6 @@ def ctrb_unchecked(A: np.ndarray, B: np.ndarray) -> np.ndarray:
     for _ in range(A.shape[0] - 1):
         blocks.append(A @ blocks[-1])
     return np.hstack(blocks)
-
-
-def numerical_rank(W: np.ndarray, tol: float | None) -> int:
-    """Numerical rank of W: singular values above tol (default NumPy's matrix_rank rule)."""
-    s = np.linalg.svd(W, compute_uv=False)
-    if tol is None:
-        tol = max(W.shape) * _EPS * (s[0] if s.size else 0.0)
-    return int(np.sum(s > tol))
 
 
 @dataclass(frozen=True)

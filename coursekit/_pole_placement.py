@@ -11,7 +11,7 @@ import warnings
 
 import numpy as np
 
-from ._pairs import balancing, numerical_rank
+from ._pairs import balancing
 from ._validation import warn_accuracy
 from .diagnostics import NotControllableError
 
@@ -38,8 +38,6 @@ ROUNDING = 1e-12
 # several inputs is refused before any work (it took minutes at n = 200, for poles that no
 # double-precision gain places anyway).
 _ROBUST_MAX_STATES = 40
-
-
 _MULTI_INPUT_MAX_STATES = 100
 
 
@@ -72,7 +70,7 @@ def place_gain(A: np.ndarray, B: np.ndarray, poles: np.ndarray):
     if B.shape[1] == 1:
         K = _single_input(A, B[:, 0], poles)
         return K, PoleMatch(A + B @ K, poles, A)
-    r = numerical_rank(B, None)
+    r = np.linalg.matrix_rank(B)
     _, _, Vt = np.linalg.svd(B)
     V_r = Vt[:r].T                                   # B V = [B_r, 0]: B_r = B V_r has full rank r
     B_r = B @ V_r if r < B.shape[1] else B

@@ -26,9 +26,8 @@ __all__ = ["ctrb", "ctrb_singular_values", "is_controllable", "charpoly", "ccf_t
 def ctrb(A, B) -> np.ndarray:
     """Controllability matrix Wc = [B, AB, A^2 B, ..., A^(n-1) B] (2.13), shape (n, n m).
 
-    This is the matrix of Kalman's criterion as the notes teach it. Its
-    numerical rank depends on units (see the module docstring): decide
-    controllability with `is_controllable`, not with ``matrix_rank(ctrb(A, B))``.
+    This is the matrix of Kalman's criterion as the notes teach it. Its numerical rank depends
+    on units (`coursekit._pairs` says why): decide with `is_controllable`, not with its rank.
     """
     A, B = as_pair(A, B)
     return ctrb_unchecked(A, B)
@@ -37,8 +36,8 @@ def ctrb(A, B) -> np.ndarray:
 def ctrb_singular_values(A, B) -> np.ndarray:
     """Singular values of Wc, largest first.
 
-    In well-scaled units the smallest says how close to uncontrollable the
-    pair is; they change with the units (the module docstring says why).
+    In well-scaled units the smallest says how close to uncontrollable the pair is; they
+    change with the units (`coursekit._pairs` says why).
     """
     return np.linalg.svd(ctrb(A, B), compute_uv=False)
 
@@ -46,17 +45,14 @@ def ctrb_singular_values(A, B) -> np.ndarray:
 def is_controllable(A, B, *, tol: float | None = None) -> bool:
     """Kalman's criterion (section 2.2.3), rank Wc = n (2.13), decided without units.
 
-    Returns the same answer for (A, B) in any time unit (A -> a A, B -> a B),
-    any state units (x -> D x, D diagonal), any input units and any
-    orthogonal change of coordinates, up to scalings far beyond 1e-4..1e4;
-    the module docstring explains the method (balancing + orthogonal
-    staircase) and why ``matrix_rank(ctrb(A, B))`` cannot promise this.
+    Returns the same answer for (A, B) in any time unit (A -> a A, B -> a B), any state units
+    (x -> D x, D diagonal), any input units and any orthogonal change of coordinates, up to
+    scalings far beyond 1e-4..1e4; `coursekit._pairs` explains the method (balancing +
+    orthogonal staircase) and why ``matrix_rank(ctrb(A, B))`` cannot promise this.
 
-    `tol` (between 0 and 1, default ``100 n^2 eps``) is the smallest coupling
-    counted as nonzero in the unit-free system, where A and the columns of B
-    have norm 1: a larger `tol` calls more nearly uncontrollable systems
-    uncontrollable. (Before coursekit 0.2 it was an absolute threshold on
-    the singular values of Wc.) Takes a few milliseconds for n = 30.
+    `tol` (between 0 and 1, default ``100 n^2 eps``) is the smallest coupling counted as nonzero
+    in the unit-free system, where A and the columns of B have norm 1: a larger `tol` calls
+    more nearly uncontrollable systems uncontrollable. A few milliseconds for n = 30.
     """
     A, B = as_pair(A, B)
     return unit_free_staircase(A, B, check_tol(tol)).rank == A.shape[0]

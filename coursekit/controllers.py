@@ -23,19 +23,13 @@ from typing import Callable
 import numpy as np
 
 from ._arguments import as_system
-from ._validation import as_matrix, as_scalar, as_square, as_vector, checked_call, float_array, require_columns
+from ._pairs import as_pair
+from ._validation import as_matrix, as_scalar, as_square, as_vector, checked_call, float_array
 from .diagnostics import UserFunctionError
 from .systems import NonlinearSystem, StateSpace
 
-__all__ = [
-    "StateFeedback",
-    "TrackingController",
-    "integral_augment",
-    "with_integrators",
-    "IntegralFeedback",
-    "integral_closed_loop",
-    "PendulumLinearizingController",
-]
+__all__ = ["StateFeedback", "TrackingController", "integral_augment", "with_integrators", "IntegralFeedback",
+           "integral_closed_loop", "PendulumLinearizingController"]
 
 
 def _fmt(v) -> str:
@@ -192,11 +186,8 @@ def integral_augment(A, B, C=None, *, integrators: int = 1):
     (A_E, B_E) is controllable exactly when (A, B) is and the plant has no
     zero at s = 0 (rank [[A, B], [C, 0]] = n + p).
     """
-    A = as_square(A, "A")
+    A, B = as_pair(A, B)
     n = A.shape[0]
-    B = as_matrix(B, "B", rows=n, rows_why=f"one per state, since A is {n}x{n}",
-                  cols=1 if np.ndim(B) == 1 else None)
-    require_columns(B.shape, "B")
     C = _output_matrix(C, n)
     q = _integrators(integrators)
     p, m = C.shape[0], B.shape[1]

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import sys
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -84,17 +85,8 @@ class EnvironmentReport:
 
 def _version_tuple(version: str) -> tuple[int, ...]:
     """'1.26.4' -> (1, 26, 4); '2.0.0rc1' -> (2, 0, 0): enough to compare with a lower bound."""
-    parts = []
-    for piece in version.split(".")[:3]:
-        digits = ""
-        for ch in piece:
-            if not ch.isdigit():
-                break
-            digits += ch
-        if not digits:
-            break
-        parts.append(int(digits))
-    return tuple(parts)
+    release = re.match(r"\d+(?:\.\d+){0,2}", version)
+    return tuple(map(int, release.group().split("."))) if release else ()
 
 
 def _installed_version(dist: str) -> str | None:

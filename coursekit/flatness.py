@@ -34,16 +34,8 @@ from ._validation import as_flag, as_matrix, as_scalar, as_vector, float_array, 
 from .controllability import ccf_transform, charpoly
 from .trajectory import plot_plan, poly_trajectory
 
-__all__ = [
-    "FlatSystem",
-    "FlatPlan",
-    "linear_flatness",
-    "pendulum_flatness",
-    "two_wheeled_flatness",
-    "car_like_flatness",
-    "plan_flat_output",
-    "plan_robot",
-]
+__all__ = ["FlatSystem", "FlatPlan", "linear_flatness", "pendulum_flatness", "two_wheeled_flatness",
+           "car_like_flatness", "plan_flat_output", "plan_robot"]
 
 
 class FlatSystem:

@@ -28,18 +28,8 @@ import numpy as np
 from ._validation import as_scalar
 from .systems import NonlinearSystem, StateSpace
 
-__all__ = [
-    "bank_account",
-    "mass_spring_damper",
-    "compartment",
-    "pendulum",
-    "lorenz",
-    "two_wheeled_robot",
-    "car_like_robot",
-    "state_example",
-    "fibonacci",
-    "vehicle",
-]
+__all__ = ["bank_account", "mass_spring_damper", "compartment", "pendulum", "lorenz", "two_wheeled_robot",
+           "car_like_robot", "state_example", "fibonacci", "vehicle"]
 
 
 def bank_account(rate: float = 0.03) -> StateSpace:

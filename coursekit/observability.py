@@ -55,13 +55,10 @@ def obsv_singular_values(A, C) -> np.ndarray:
 def is_observable(A, C, *, tol: float | None = None) -> bool:
     """Kalman's criterion (4.14)-(4.15), rank Wo = n, decided without units.
 
-    By duality (Wo is the transpose of the controllability matrix of
-    (A^T, C^T)) this is ``is_controllable(A.T, C.T, tol=tol)``: the same
-    answer in any time unit, state units, output units and coordinates;
-    `controllability` explains the method (balancing + orthogonal staircase)
-    and why ``matrix_rank(obsv(A, C))`` cannot promise this. It also works
-    for several outputs, where Wo is not square and the notes'
-    ``det(Wo) != 0`` test does not apply. `tol` as in `is_controllable`.
+    By duality (Wo is the transpose of the controllability matrix of (A^T, C^T)) this is
+    ``is_controllable(A.T, C.T, tol=tol)``: the same answer in any units and coordinates, for
+    the reasons `coursekit._pairs` gives. It also works for several outputs, where Wo is not
+    square and the notes' ``det(Wo) != 0`` test does not apply. `tol` as in `is_controllable`.
     """
     A, C = as_obs_pair(A, C)
     return unit_free_staircase(A.T, C.T, check_tol(tol)).rank == A.shape[0]

@@ -25,13 +25,8 @@ from ._arguments import as_system
 from ._validation import as_matrix, as_series
 from .systems import StateSpace
 
-__all__ = [
-    "observer_system",
-    "plant_with_observer",
-    "output_feedback",
-    "observer_tracking_input",
-    "separation_eigenvalues",
-]
+__all__ = ["observer_system", "plant_with_observer", "output_feedback", "observer_tracking_input",
+           "separation_eigenvalues"]
 
 
 def _plant(sys) -> StateSpace:

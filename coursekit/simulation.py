@@ -14,16 +14,9 @@ Three paths, chosen from the system and the input:
   `scipy.integrate.solve_ivp` with the DOP853 method and tight tolerances
   (rtol=1e-9, atol=1e-12 by default).
 
-Nothing hangs and nothing fails silently. The solver options are checked
-before anything runs. The user's functions -- the model f, the output map h,
-an input u(t, x) -- are called once at the start and then watched at every
-evaluation (a plain call and one finiteness test, so the guard costs little);
-the first exception or NaN/inf stops the simulation with a `UserFunctionError`
-that names the function, the time and the state. A state that leaves the
-float range (an unstable system simulated for too long, a finite escape
-time), and an ODE solver that gives up, raise a `SimulationError` saying when
-and why, instead of returning a curve that turns into inf/NaN and vanishes
-from the plot.
+Nothing hangs and nothing fails silently: the options are checked before anything runs, the
+user's functions are called once at the start and watched at every evaluation (`_Model`), and
+the errors say when and why (`simulate`, Raises).
 """
 
 from __future__ import annotations
@@ -34,9 +27,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from ._arguments import as_system
+from ._pairs import as_pair
 from ._stepping import check_finite, overflow_error, step_matrices
-from ._validation import (agrees_column_by_column, as_matrix, as_scalar, as_series, as_square, as_time_grid,
-                          as_vector, call_user, checked_call, is_uniform, require_columns)
+from ._validation import (agrees_column_by_column, as_matrix, as_scalar, as_series, as_time_grid, as_vector,
+                          call_user, checked_call, is_uniform)
 from .diagnostics import SimulationError, UserFunctionError
 from .systems import NonlinearSystem, StateSpace
 
@@ -518,11 +512,7 @@ def lti_step_matrices(A, B, h):
     a step h that is not a finite number > 0; `SimulationError` when
     e^(A h) is beyond the float range (an unstable A and a long step).
     """
-    A = as_square(A, "A")
-    n = A.shape[0]
-    B = as_matrix(B, "B", rows=n, rows_why=f"one per state, since A is {n}x{n}",
-                  cols=1 if np.ndim(B) == 1 else None)
-    require_columns(B.shape, "B")
+    A, B = as_pair(A, B)
     return step_matrices(A, B, as_scalar(h, "h", positive=True))
 
 

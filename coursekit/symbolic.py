@@ -16,13 +16,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from functools import lru_cache
 
-__all__ = [
-    "SymbolicFlatMaps",
-    "symbolic_ctrb",
-    "symbolic_mass_spring_damper",
-    "symbolic_linear_flatness",
-    "symbolic_flat_maps",
-]
+__all__ = ["SymbolicFlatMaps", "symbolic_ctrb", "symbolic_mass_spring_damper", "symbolic_linear_flatness",
+           "symbolic_flat_maps"]
 
 _SYSTEMS = ("pendulum", "two_wheeled", "car_like")
 

@@ -291,21 +291,13 @@ def poly_trajectory(T, start, end) -> PolyTrajectory:
     ``start = [y(0), y'(0), ..., y^(r-1)(0)]`` and likewise `end` at T give
     the unique polynomial of degree 2r - 1 (r = 2 is the cubic (2.33)).
 
-    Returns a `PolyTrajectory` ``traj`` with ``traj(t, k=0)`` the k-th
-    derivative. Instead of solving (2.37) in powers of t (hopeless for long
-    horizons or many conditions: the matrix holds T, T^2, ..., T^(2r-1)),
-    the polynomial is written in closed form in the normalized time
-    tau = t / T with a two-point Hermite basis (see `PolyTrajectory`).
-
-    Guarantees, for r up to 20 and any T whose powers T^k (k < 2r) stay in
-    double range: each boundary value and derivative is met to a few units in
-    the last place of its own value, and every derivative on [0, T] is within
-    about 50 eps of that derivative's largest value there. A T for which a
-    derivative on [0, T] leaves the float range (inf or NaN) raises a
-    ValueError naming T. After building,
-    the 2r boundary conditions are evaluated; a miss of more than
-    32 eps of the value (possible only when y^(k) T^k over- or underflows)
-    gives an `AccuracyWarning` saying which derivative, at which end, by how much.
+    Returns a `PolyTrajectory` ``traj`` with ``traj(t, k=0)`` the k-th derivative, written in
+    closed form in tau = t / T rather than by solving (2.37) in powers of t (a matrix of T, ...,
+    T^(2r-1): hopeless for long horizons or many conditions); its accuracy is `PolyTrajectory`'s
+    for any T whose powers T^k (k < 2r) stay in double range. A T for which a derivative on
+    [0, T] leaves the float range raises a ValueError naming T; a boundary condition missed by
+    more than 32 eps of its value (possible only when y^(k) T^k over- or underflows) gives an
+    `AccuracyWarning` saying which derivative, at which end, by how much.
     """
     T = as_scalar(T, "T", positive=True)
     start = as_vector(start, "start")
@@ -543,15 +535,11 @@ def open_loop_control(A, B, x0, xT, T, *, smooth: int = 0) -> OpenLoopPlan:
     3. plan y_d = z1 as the polynomial of degree 2n - 1 with
        y_d^(k)(0) = z0[k], y_d^(k)(T) = zT[k] (2.31)-(2.38);
     4. apply the feedforward u_d (2.25) with the CCF's a and b = 1;
-    5. check the plan: its own x(0) = T^-1 z(0) and x(T), and the end state of
-       the plant driven by u_d (x' = A x + B u_d solved exactly, see
-       `_landing`), must meet x0 and xT to 1e-6 of max(|x0|, |xT|); otherwise
-       an `AccuracyWarning` says which one misses, by how much, how far the
-       plan swings on the way and what to try. The trajectory itself meets
-       its boundary conditions to rounding (`poly_trajectory`), so a miss comes
-       from the plant: a plan whose states pass through values ~1e9 times the
-       task's size (high n, a badly scaled model) cannot land in double
-       precision.
+    5. check the plan (`_check_plan`): its own x(0) and x(T), and the end state of the plant
+       driven by u_d (solved exactly, `_landing`), must meet x0 and xT to 1e-6 of
+       max(|x0|, |xT|), else an `AccuracyWarning` says which misses, by how much and what to
+       try. The trajectory meets its boundary conditions to rounding, so a miss comes from
+       the plant: states passing through ~1e9 times the task's size cannot land in doubles.
 
     ``smooth = s > 0`` adds s more boundary conditions, y_d^(n)..y_d^(n+s-1)
     = 0 at both ends (degree 2(n + s) - 1): then u_d starts and ends at the

@@ -1,12 +1,13 @@
-"""The course's website and slides, built once per test session for every test that reads them
+"""The course's website and slides, built once per test run for every test that reads them
 (the session fixture ``course_builds`` of tests/conftest.py, a `CourseBuilds`).
 
 * `site`: both editions of the website from one execution of the chapters, as
   ``python -m coursekit site --out DIR --student-out DIR`` builds them (tests/test_site_browser.py
   opens them in Chromium; tests/test_build_structure.py compares what they show with its record);
-* `slides`: the slides of the whole course, as ``python -m coursekit slides`` builds them, the
-  chapters the session executed already replayed rather than executed again
-  (`executed_chapters.replaying`; tests/test_slides.py, tests/test_build_structure.py).
+* `slides`: the slides of the whole course, built by `build_slides` (what ``python -m coursekit
+  slides`` calls), the chapters the session executed already replayed rather than executed again
+  (its `execute` argument, `executed_chapters.replaying`; tests/test_slides.py,
+  tests/test_build_structure.py).
 
 Each is built once per run, when a test first asks for it, however many xdist workers ask; the
 tests skip themselves when a tool is missing.
@@ -18,6 +19,7 @@ import time
 from pathlib import Path
 
 from coursekit.__main__ import main
+from coursekit.tools.slideshow import build_slides
 from executed_chapters import ExecutedChapters, replaying
 from run_once import once, shared_folder
 
@@ -43,8 +45,7 @@ class CourseBuilds:
 
     def _build_slides(self, out: Path) -> None:
         start = time.monotonic()
-        with replaying(self._executed):
-            assert main(["slides", "--out", str(out / "slides")]) == 0
+        build_slides(out / "slides", verbose=True, execute=replaying(self._executed))
         print(f"\nslides of the course built in {time.monotonic() - start:.0f} s")
 
 

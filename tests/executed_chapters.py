@@ -18,13 +18,12 @@ interpreter, by the first xdist worker that asks, and written to the run's share
 
 from __future__ import annotations
 
-import contextlib
 import copy
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Callable
 
 import nbformat
-import pytest
 
 from coursekit.tools.notebooks import default_notebook_dir, execute_all, read_notebook, write_notebook
 from coursekit.tools.slideshow import DESCRIBE_FIGURES
@@ -121,24 +120,20 @@ def replay_into(nb, executed, *, drop: tuple[str, ...] = ()) -> None:
     nb.metadata["language_info"] = copy.deepcopy(executed.metadata.get("language_info", {}))
 
 
-@contextlib.contextmanager
-def replaying(executed_chapters: ExecutedChapters):
-    """While open, a build of the slides (``python -m coursekit slides``) executes only the
-    chapters `executed_chapters` has not executed: the others take the outputs of the shared
-    copies (`replay_into`, without the figure checks' reports), which must match them cell by cell."""
-    from coursekit.tools import notebooks
-    execute = notebooks._execute_all
-
-    async def replayed(nbs, sources, **kwargs):
+def replaying(executed_chapters: ExecutedChapters) -> Callable:
+    """An `execute_all` for ``build_slides(execute=...)`` that executes only the chapters
+    `executed_chapters` has not executed: the others take the outputs of the shared copies
+    (`replay_into`, without the figure checks' reports), which must match them cell by cell."""
+    def execute(notebooks: list, paths: list[Path], *, prelude: str = "", **options) -> None:
         rest = []
-        for nb, path in zip(nbs, sources):
+        for nb, path in zip(notebooks, paths):
             if executed_chapters.has_instructor(path.name):
+                nb.cells.insert(0, nbformat.v4.new_code_cell(prelude))
                 replay_into(nb, executed_chapters.instructor(path.name), drop=(REPORT,))
+                nb.cells.pop(0)
             else:
                 rest.append((nb, path))
         if rest:
-            await execute([nb for nb, _ in rest], [path for _, path in rest], **kwargs)
+            execute_all([nb for nb, _ in rest], [path for _, path in rest], prelude=prelude, **options)
 
-    with pytest.MonkeyPatch.context() as patch:
-        patch.setattr(notebooks, "_execute_all", replayed)
-        yield
+    return execute

@@ -21,9 +21,9 @@ import pytest
 import sympy as sp
 
 import coursekit.exercises as ex
-from coursekit.tools.chapters import chapter_modules
+from coursekit.tools.chapters import check_functions, exercises
 from coursekit.exercises._answers import ANSWERS_ENV, decode, read_last_records
-from coursekit.exercises._catalog import CATALOG, STATE
+from coursekit.exercises._catalog import STATE
 from coursekit.exercises._progress import CORRECT, NOT_TRIED, NOT_YET
 
 NOTEBOOKS = sorted((Path(__file__).resolve().parents[1] / "notebooks").glob("0*.ipynb"))
@@ -55,9 +55,9 @@ def test_the_catalog_is_the_notebook_exercises_in_order(path):
     cells = ["".join(c["source"]) for c in json.loads(path.read_text(encoding="utf-8"))["cells"]]
     labels = re.findall(r"^### Exercise (\d+\.\d+):", "\n".join(cells), re.M)
     chapter = int(path.name[:2])
-    assert labels == [e.label for e in CATALOG[chapter]]
+    assert labels == [e.label for e in ex.chapter_exercises(chapter)]
     called = [m for c in cells if not c.startswith("<details>") for m in re.findall(r"ex\.(check_\w+)\(", c)]
-    assert list(dict.fromkeys(called)) == [e.check for e in CATALOG[chapter]]
+    assert list(dict.fromkeys(called)) == [e.check for e in ex.chapter_exercises(chapter)]
     assert f"ex.progress({chapter})" in cells[-1], "the last cell shows the chapter's progress"
 
 
@@ -87,7 +87,7 @@ def test_run_all_on_a_fresh_chapter_leaves_every_exercise_not_tried_and_unanswer
     answers = tmp_path / "answers.jsonl"
     monkeypatch.setenv(ANSWERS_ENV, str(answers))
     cells = _answer_cells(path)
-    assert len(cells) == len(CATALOG[int(path.name[:2])])
+    assert len(cells) == len(ex.chapter_exercises(int(path.name[:2])))
     for source in cells:
         with contextlib.redirect_stdout(io.StringIO()) as printed:
             exec(source, {"ex": ex, "display": lambda *objects: None})      # as the notebook runs it
@@ -137,7 +137,7 @@ def test_text_and_html_show_sections_and_states_but_no_answer():
     shown = ex.progress(1)
     text, page = repr(shown), shown._repr_html_()
     assert text.startswith("Chapter 1: 1 of 5 exercises correct, 1 not yet, 3 not tried")
-    for entry in CATALOG[1]:
+    for entry in ex.chapter_exercises(1):
         assert entry.label in text and entry.section in text and entry.section in page
     assert "correct" in page and "not yet" in page and "not tried" in page and "<table" in page
     for answer in ("-4", "0.5", "-0.2", "[[1, 2]"):
@@ -146,7 +146,16 @@ def test_text_and_html_show_sections_and_states_but_no_answer():
 
 def _chapters() -> list[int]:
     """The chapters with exercises, from the course's one registry (a fifth one added by docs/extending.md too)."""
-    return [int(module.__name__.rsplit("ch", 1)[1]) for module in chapter_modules("exercises")]
+    return list(exercises())
+
+
+def test_the_exercises_are_the_declared_checks_of_their_chapter_modules():
+    """One registry: each check of a module chN is an exercise of chapter N under its own name, and
+    every exercise `progress` and the grader list is such a check."""
+    checks = check_functions()
+    assert {f"ch{e.chapter}.{e.check}" for found in exercises().values() for e in found} == set(checks)
+    assert all(check.exercise.check == label.split(".")[1] for label, check in checks.items())
+    assert [e.check for e in ex.chapter_exercises(2)] == [name for name in ex.ch2.__all__ if name.startswith("check_")]
 
 
 def test_every_chapter_when_none_is_given():

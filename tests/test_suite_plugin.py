@@ -12,7 +12,7 @@ import pytest
 
 import lab_harness
 import suite_plugin
-from executed_chapters import replay_into
+from executed_chapters import replay_into, replaying
 
 _BROWSER_TESTS = """
 import pytest
@@ -197,3 +197,22 @@ def test_replay_gives_the_shared_outputs_to_the_same_notebook_only():
     other_prelude = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in ("frames()", "x = 1", "plot(x)")])
     with pytest.raises(AssertionError, match="prelude differs"):
         replay_into(other_prelude, shared)
+
+
+def test_replaying_executes_like_execute_all_but_replays_the_shared_chapters():
+    """The slides' build takes it as its `execute`: a chapter executed already gets its outputs, as
+    execute_all leaves a notebook (no prelude cell kept), and nothing is executed for it."""
+    shared = _ran("describe()\nreport()", "x = 1", "plot(x)")
+
+    class Shared:
+        def has_instructor(self, name):
+            return name == "01_a.ipynb"
+
+        def instructor(self, name):
+            assert name == "01_a.ipynb"
+            return shared
+
+    nb = nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell(s) for s in ("x = 1", "plot(x)")])
+    replaying(Shared())([nb], [Path("01_a.ipynb")], prelude="describe()", timeout=1, what="the slides")
+    assert [c.source for c in nb.cells] == ["x = 1", "plot(x)"]
+    assert [c.outputs[0]["data"]["text/plain"] for c in nb.cells] == ["out 1", "out 2"]

@@ -5,8 +5,9 @@ Each ``check_*`` of the chapter modules is declared with `exercise`::
     @exercise("1.1", "the mass-spring-damper in state-space form", section="1.6 Bridges")
     def check_msd_state_space(A, B, C) -> CheckResult: ...
 
-which lists it in `CATALOG` (the chapter comes from the label) and wraps it so
-that every call
+which gives it its `Exercise` record as the attribute ``exercise`` (the chapter comes from
+the label; `coursekit._chapters`, the course's one registry, finds the checks of every chapter
+module by it) and wraps it so that every call
 
 * appends the answer to the grader's answers file when one is set
   (`coursekit.exercises._answers.append_record`, before the check runs, so an
@@ -33,9 +34,10 @@ import inspect
 from dataclasses import dataclass
 from typing import Callable
 
+from .._chapters import exercises
 from ._answers import Tape, append_record
 
-__all__ = ["Exercise", "CATALOG", "STATE", "exercise", "chapter_exercises", "chapters"]
+__all__ = ["Exercise", "STATE", "exercise", "chapter_exercises", "chapters"]
 
 
 @dataclass(frozen=True)
@@ -51,9 +53,6 @@ class Exercise:
     def chapter(self) -> int:
         return int(self.label.split(".")[0])
 
-
-#: chapter number -> its exercises in the order of the notebook
-CATALOG: dict[int, list[Exercise]] = {}
 
 #: name of a check -> True (last answer correct) or False (not yet), for the checks called this session
 STATE: dict[str, bool] = {}
@@ -117,15 +116,15 @@ def _is_data(value) -> bool:
 def exercise(label: str, title: str, *, section: str) -> Callable[[Callable], Callable]:
     """Declare a check as the check of exercise `label` (see the module docstring)."""
     def declare(check: Callable) -> Callable:
-        entry = Exercise(label, title, section, check.__name__)
-        CATALOG.setdefault(entry.chapter, []).append(entry)
-        return _wrap(check)
+        recorded = _wrap(check)
+        recorded.exercise = Exercise(label, title, section, check.__name__)
+        return recorded
     return declare
 
 
 def chapters() -> list[int]:
     """The chapters that have exercises, in order."""
-    return sorted(CATALOG)
+    return list(exercises())
 
 
 def chapter_exercises(chapter) -> list[Exercise]:
@@ -133,6 +132,7 @@ def chapter_exercises(chapter) -> list[Exercise]:
     if isinstance(chapter, bool) or not isinstance(chapter, int):
         raise TypeError(f"chapter must be a chapter number such as 1, received {chapter!r}; "
                         f"the chapters with exercises are {chapters()}.")
-    if chapter not in CATALOG:
-        raise ValueError(f"chapter {chapter} has no exercises: pass one of {chapters()}.")
-    return list(CATALOG[chapter])
+    found = exercises()
+    if chapter not in found:
+        raise ValueError(f"chapter {chapter} has no exercises: pass one of {list(found)}.")
+    return found[chapter]

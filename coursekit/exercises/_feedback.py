@@ -32,20 +32,9 @@ import numpy as np
 
 from .._validation import is_complex
 
-__all__ = [
-    "CheckResult",
-    "Report",
-    "feedback_to",
-    "close",
-    "read_matrix",
-    "read_poles",
-    "read_numbers",
-    "read_decision",
-    "matrix_feedback",
-    "poles_feedback",
-    "call_student_function",
-    "rank_decision_feedback",
-]
+__all__ = ["CheckResult", "Report", "feedback_to", "close", "read_matrix", "read_poles", "read_numbers",
+           "read_decision", "matrix_feedback", "poles_feedback", "call_student_function",
+           "rank_decision_feedback"]
 
 #: where `Report.show` prints in this thread or task (None: standard output)
 _STREAM: contextvars.ContextVar[IO[str] | None] = contextvars.ContextVar("coursekit_feedback", default=None)

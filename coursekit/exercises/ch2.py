@@ -45,23 +45,16 @@ CAR = ExerciseData({"L": 2.5, "dF": (3.0, 4.0), "ddF": (-1.0, 2.0)})
 TRAJECTORY = ExerciseData({"T": 2.0, "x0": (0.0, 1.0), "xT": (2.0, 0.0)})
 
 
-def _blocks(A: np.ndarray, B: np.ndarray) -> list[np.ndarray]:
-    blocks = [B]
-    for _ in range(A.shape[0] - 1):
-        blocks.append(A @ blocks[-1])
-    return blocks
-
-
 @exercise("2.1", "the controllability matrix",
           section="2.2 Controllability and the Kalman criterion")
 def check_ctrb_matrix(Wc) -> CheckResult:
     """Check the controllability matrix Wc = [B, AB, A^2 B] of `CTRB` (2.13)."""
     report = Report("controllability matrix")
     A, B = np.array(CTRB["A"]), np.array(CTRB["B"])
-    blocks = _blocks(A, B)
-    matrix_feedback(Wc, ctrb(A, B), "Wc", report, known_mistakes=[
-        (np.hstack(blocks[::-1]), "Wc: the columns are in reverse order: B comes first, then AB, "
-                                  "then A^2 B (2.13)."),
+    Wc_ok = ctrb(A, B)   # (2.13); one input, so a block is a column
+    matrix_feedback(Wc, Wc_ok, "Wc", report, known_mistakes=[
+        (Wc_ok[:, ::-1], "Wc: the columns are in reverse order: B comes first, then AB, "
+                         "then A^2 B (2.13)."),
     ], shape_hint="Wc stacks the columns B, AB, A^2 B side by side: n x n for one input "
         "((2.13) prints A as the first block: a typo, the first block is B, see (2.12)).",
         entry_hint="Compute AB = A @ B and A^2 B = A @ (A @ B) and put them side by side (2.13).")

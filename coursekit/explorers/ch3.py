@@ -22,15 +22,8 @@ from ..style import PALETTE, course_subplots, curve_style
 from ._base import Explorer, slider
 from .limits import rescale
 
-__all__ = [
-    "pair_poles",
-    "pole_placement_compute",
-    "pole_placement_explorer",
-    "upright_pendulum_compute",
-    "upright_pendulum_explorer",
-    "integral_action_compute",
-    "integral_action_explorer",
-]
+__all__ = ["pair_poles", "pole_placement_compute", "pole_placement_explorer", "upright_pendulum_compute",
+           "upright_pendulum_explorer", "integral_action_compute", "integral_action_explorer"]
 
 #: plant of the pole-placement explorer: (3.22) driven through its first input only
 PLACEMENT_A = np.array([[2.0, 0.0, 0.0], [1.0, -1.0, 2.0], [0.0, 2.0, -1.0]])

@@ -45,23 +45,9 @@ from .notebooks import (WIDGET_VIEW, execute_all, harvest_alt_texts, read_notebo
                         write_notebook)
 from .release import student_edition, student_text
 
-__all__ = [
-    "build_site",
-    "erratum_admonitions",
-    "fold_solution_code",
-    "chapter_entry",
-    "landing_page",
-    "sphinx_conf",
-    "missing_site_tools",
-    "repository_of",
-    "for_the_site",
-    "github_repository",
-    "SMALLEST_TEXT",
-    "FIGURE_RECORD",
-    "SITE_FIGURES",
-    "figure_text_sizes",
-    "SMALLEST_TEXT",
-]
+__all__ = ["build_site", "erratum_admonitions", "fold_solution_code", "chapter_entry", "landing_page", "sphinx_conf",
+           "missing_site_tools", "repository_of", "for_the_site", "github_repository", "SMALLEST_TEXT",
+           "FIGURE_RECORD", "SITE_FIGURES", "figure_text_sizes"]
 
 #: the theme's search button says "Search" to a screen reader but shows "Search ... Ctrl+K": its
 #: accessible name becomes the text it shows (WCAG 2.5.3, label in name)

@@ -46,8 +46,9 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from ..._chapters import exercises
 from ...exercises._answers import ANSWERS_ENV, decode, read_last_records
-from ...exercises._catalog import CATALOG, chapter_exercises
+from ...exercises._catalog import chapter_exercises
 from ...exercises._feedback import feedback_to
 from ..notebooks import write_notebook
 from .kernel import kernel_argv
@@ -110,7 +111,7 @@ def _chapter_of(nb) -> int | None:
             if match:
                 return int(match[1])
     code = "\n".join(cell.source for cell in nb.cells if cell.cell_type == "code")
-    called = {number for number, entries in CATALOG.items() for entry in entries
+    called = {number for number, entries in exercises().items() for entry in entries
               if re.search(rf"\b{entry.check}\s*\(", code)}
     return called.pop() if len(called) == 1 else None
 
