@@ -26,7 +26,7 @@ from PIL import Image
 
 from coursekit.tools.chapters import explorer_factories
 
-__all__ = ["check_page", "factories_by_title"]
+__all__ = ["check_page", "explorer_data"]
 
 _STATE_JS = """root => {
   const img = root.querySelector('img.ck-static-figure');
@@ -38,6 +38,13 @@ _STATE_JS = """root => {
             i.tagName === 'SELECT' ? i.selectedIndex : Number(i.value)),
           valuetexts: [...root.querySelectorAll('input[type=range]')].map(i => i.getAttribute('aria-valuetext'))};
 }"""
+
+#: records the state (as `_STATE_JS` reads it) after each input event, the page's own handler
+#: having run first; `_TAKE_JS` hands out the records and clears them
+_LOG_JS = """root => { if (root.ckLog) return; root.ckLog = [];
+  const read = """ + _STATE_JS + """;
+  root.querySelectorAll('[data-ck-control]').forEach(i => i.addEventListener('input', () => root.ckLog.push(read(root)))); }"""
+_TAKE_JS = "root => root.ckLog.splice(0)"
 
 _LABELS_JS = """root => [...root.querySelectorAll('[data-ck-control]')].map(i =>
   i.labels.length === 1 && i.labels[0].textContent.trim().length > 0)"""
@@ -58,15 +65,16 @@ _COUNT_JS = """root => { root.ckInputs = 0;
       x.tagName === 'SELECT' ? x.selectedIndex : x.value).join(','); }"""
 
 
-_FACTORIES: dict = {}
+_EXPLORERS: dict = {}
 
 
-def factories_by_title() -> dict:
-    """{an explorer's title: its factory} for every explorer of the course."""
-    if not _FACTORIES:
+def _explorers_by_title() -> dict:
+    """{an explorer's title: (its factory, an explorer it made)} for every explorer of the course."""
+    if not _EXPLORERS:
         for factory in explorer_factories().values():
-            _FACTORIES[factory().title] = factory
-    return _FACTORIES
+            explorer = factory()
+            _EXPLORERS[explorer.title] = (factory, explorer)
+    return _EXPLORERS
 
 
 def _settings_text(data: dict, state: list[int]) -> str:
@@ -92,17 +100,18 @@ def _data(root) -> dict:
     return dict(script=script, controls=controls)
 
 
-def _names(factory, data: dict) -> None:
-    explorer = factory()
+def _names(explorer, data: dict) -> None:
     for control, name in zip(data["controls"], explorer.controls):
         control["name"] = name
 
 
 def _step_everywhere(page, root, data: dict, shown: list) -> None:
-    """Every value of every range input, with the keyboard, for each choice of each dropdown."""
+    """Every value of every range input, with the keyboard, for each choice of each dropdown: each
+    state is read in the page as it is reached (`_LOG_JS`), and checked here."""
     controls = data["controls"]
     selects = [j for j, c in enumerate(controls) if c["kind"] == "select"]
     choices = [[]] + [[(j, i)] for j in selects for i in range(len(controls[j]["values"]))]
+    root.evaluate(_LOG_JS)
     for choice in choices:
         for j, c in enumerate(controls):
             root.evaluate(_SET_JS, [j, c["default"]]) if c["kind"] == "range" else None
@@ -111,17 +120,21 @@ def _step_everywhere(page, root, data: dict, shown: list) -> None:
         for j, control in enumerate(controls):
             if control["kind"] != "range":
                 continue
-            handle = root.locator("[data-ck-control]").nth(j)
-            handle.focus()
+            root.locator("[data-ck-control]").nth(j).focus()
             page.keyboard.press("Home")
-            for _ in range(len(control["values"])):
-                state = root.evaluate(_STATE_JS)
+            root.evaluate(_TAKE_JS)
+            states = [root.evaluate(_STATE_JS)]
+            for _ in range(len(control["values"]) - 1):
+                page.keyboard.press("ArrowRight")
+            states += root.evaluate(_TAKE_JS)
+            assert [s["state"][j] for s in states] == list(range(len(control["values"]))), \
+                f"the arrow keys did not step through every value: {[s['state'] for s in states]}"
+            for state in states:
                 assert state["loaded"], f"a reachable state without a loaded frame: {state}"
                 assert _settings_text(data, state["state"]) in state["alt"], (state["state"], state["alt"])
                 assert state["valuetexts"][sum(c["kind"] == "range" for c in controls[:j])] == \
                     control["texts"][state["state"][j]]
                 shown.append(tuple(state["state"]))
-                page.keyboard.press("ArrowRight")
 
 
 def _drag(page, root, j: int, count: int) -> dict:
@@ -140,10 +153,12 @@ def _drag(page, root, j: int, count: int) -> dict:
     return before
 
 
-def check_page(page, folder: Path, *, column: bool, scroll=None) -> int:
+def check_page(page, folder: Path, *, column: bool, scroll=None, every_state: bool = True) -> int:
     """Check every explorer of the chapter `page` shows (see the module's doc); its frames are
     files of `folder` (the page's own folder), drawn for the website's column when `column`.
-    `scroll(root)` brings an explorer into view (default: scroll it into view). Returns how many
+    `scroll(root)` brings an explorer into view (default: scroll it into view). Without
+    `every_state`, the keyboard's walk through every state is left out (for a page whose explorers
+    hold the same data and frames as a page checked with it: `same_explorers`). Returns how many
     explorers were checked."""
     from test_static_explorers import assert_shows    # the figure a fresh explorer shows after one move
     roots = page.locator(".ck-static-explorer")
@@ -154,11 +169,12 @@ def check_page(page, folder: Path, *, column: bool, scroll=None) -> int:
         assert all(root.evaluate(_LABELS_JS)), "an input without its label"
         data = _data(root)
         title = root.locator(".ck-static-title").inner_text().strip()
-        factory = factories_by_title()[title]
-        _names(factory, data)
-        shown: list = []
-        _step_everywhere(page, root, data, shown)
-        assert set(shown) <= {tuple(map(int, k.split(","))) for k in data["script"]["states"]}
+        factory, explorer = _explorers_by_title()[title]
+        _names(explorer, data)
+        if every_state:
+            shown: list = []
+            _step_everywhere(page, root, data, shown)
+            assert set(shown) <= {tuple(map(int, k.split(","))) for k in data["script"]["states"]}
         for j, control in enumerate(data["controls"]):
             if control["kind"] != "range":
                 continue
@@ -181,3 +197,10 @@ def check_page(page, folder: Path, *, column: bool, scroll=None) -> int:
             alt = assert_shows(factory, settings, frame, column=column)
             assert after["alt"] == alt, (after["alt"], alt)
     return roots.count()
+
+
+def explorer_data(page, folder: Path) -> list:
+    """What each explorer of `page` shows: its data as the page holds it, each frame's file as bytes."""
+    scripts = page.locator(".ck-static-explorer script.ck-static-data").all_text_contents()
+    return [(script, [(folder / frame["src"]).read_bytes() for frame in json.loads(script)["frames"]])
+            for script in scripts]

@@ -3,6 +3,7 @@ stores, that each frame is the figure JupyterLab shows for its settings, and the
 the builds write. In a browser: tests/test_site_browser.py and tests/test_slides.py."""
 
 import base64
+import functools
 import html
 import io
 import json
@@ -108,6 +109,12 @@ def test_bad_arguments_are_named(call, error, match):
 
 # -- each frame is the figure of its settings -------------------------------------------------
 
+@functools.lru_cache(maxsize=64)     # each a few MB: the site's two editions ask for the same
+def _one_move_cached(factory, settings: tuple, column: bool) -> tuple[np.ndarray, str]:
+    image, alt = _one_move(factory, dict(settings), column=column)
+    return image.astype(np.uint8), alt
+
+
 def _one_move(factory, settings: dict, *, column: bool) -> tuple[np.ndarray, str]:
     """The figure a fresh explorer shows in JupyterLab after one move to `settings` (a single
     control changed), as the website draws it (`column`) or at its natural size, and its alt."""
@@ -130,7 +137,8 @@ def assert_shows(factory, settings: dict, shown: np.ndarray, *, column: bool) ->
     """Assert that `shown` (pixels) is the figure of `settings`: equal, within 2 levels per pixel,
     to a fresh explorer's after one move to them (every explorer, the robot planner's path of one
     scale too: its limits depend on the settings alone). Returns the fresh explorer's alt text."""
-    reference, alt = _one_move(factory, settings, column=column)
+    reference, alt = _one_move_cached(factory, tuple(sorted(settings.items())), column)
+    reference = reference.astype(int)
     assert shown.shape == reference.shape, settings
     assert np.abs(shown - reference).max() <= 2, settings      # a blit's antialiasing: 1 level
     return alt
