@@ -191,6 +191,30 @@ def test_an_artist_drawn_over_a_moving_one_is_drawn_again_with_it():
     np.testing.assert_array_equal(_pixels(frames.frame()), _pixels(_drawn_whole(fig)))
 
 
+def test_an_artist_placed_in_data_coordinates_is_measured_again_when_the_limits_move():
+    """Which artists can meet a moving one is measured once while the text and layout stay (a
+    legend's extent costs a tenth of a full draw), except for those placed in data coordinates:
+    new limits can bring them onto the data, where they must be drawn again over the moving curve."""
+    fig = Figure(figsize=(4, 3))
+    ax = fig.subplots()
+    line, = ax.plot([0, 1], [0, 1], lw=8)
+    ax.set_ylim(0, 1)
+    label = ax.text(0.5, 5.0, "MMMM", fontsize=30, zorder=5, ha="center", va="center")   # above the view
+    frames = FrameRenderer(fig)
+    frames.frame()
+    line.set_data([0, 1], [0, 0.9])
+    frames.frame()
+    assert not label.get_animated()
+    ax.set_ylim(0, 10)                   # the label is on the data now: a full draw
+    line.set_data([0, 1], [5.0, 5.0])
+    frames.frame()
+    assert label.get_animated()
+    line.set_data([0, 1], [5.1, 5.1])    # a blit: the curve right under the label
+    blits = frames.blits
+    np.testing.assert_array_equal(_pixels(frames.frame()), _pixels(_drawn_whole(fig)))
+    assert frames.blits == blits + 1
+
+
 def test_rescale_at_rest_depends_on_the_data_alone_rounded_out_to_a_round_step():
     ax = Figure().subplots()
     line, = ax.plot([0, 1], [0, 1])

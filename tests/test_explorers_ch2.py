@@ -112,3 +112,22 @@ def test_the_robot_planner_s_path_is_on_one_scale_with_limits_a_draw_keeps_and_l
         assert metre_x == pytest.approx(metre_y, rel=1e-3), settings
         with drawn_for_the_column(e.fig, e.natural_dpi):
             assert text_problems(e.fig) == [], settings
+
+
+def test_the_robot_planner_s_plane_holds_every_target_so_a_target_step_keeps_its_limits():
+    """Issue 34: every step of a target moved the plane's limits, so each key step drew the whole
+    figure. The plane holds the square of the targets the sliders offer: a step is blitted."""
+    e = ch2.robot_planner_explorer()
+    ax = e.handles["ax"]
+    shown = ax.get_xlim(), ax.get_ylim()
+    box = e.controls["x_T"].min, e.controls["x_T"].max
+    assert shown[0][0] <= box[0] and box[1] <= shown[0][1] and shown[1][0] <= box[0] and box[1] <= shown[1][1]
+    for name, values in (("x_T", (3.5, 3.0, 2.5, 6.0, 5.5)), ("y_T", (2.5, 3.0, 1.5, -2.0))):
+        for value in values:
+            e.controls[name].value = value
+            assert (ax.get_xlim(), ax.get_ylim()) == shown, (name, value)
+    e.controls["y_T"].value, e.controls["x_T"].value = 2.0, 4.0
+    draws = e.frames.full_draws
+    for value in (3.5, 3.0, 2.5):          # the inputs stay in their limits here too: blitted
+        e.controls["x_T"].value = value
+    assert e.frames.full_draws == draws

@@ -98,3 +98,23 @@ def test_the_pendulum_started_upright_is_drawn_flat_not_its_numerical_noise():
     e.refresh()
     low, high = e.handles["ax_th"].get_ylim()
     assert high >= 30.0 and high - low < 60.0 + 30.0
+
+
+def test_a_step_of_the_pendulum_s_initial_angle_keeps_the_limits_within_an_eighth_turn():
+    """Issue 34: every 5 degree step moved both axes' limits (each key step drew the whole figure).
+    The angle axis holds whole eighth turns from upright, the torque axis the torque limit."""
+    e = ch3.upright_pendulum_explorer()
+    ax_th, ax_u = e.handles["ax_th"], e.handles["ax_u"]
+    shown = ax_th.get_ylim(), ax_u.get_ylim()
+    e.controls["theta0_deg"].value = 35.0      # the first frame after the explorer's is drawn whole
+    draws = e.frames.full_draws
+    for value in (40.0, 45.0, 25.0, 5.0):
+        e.controls["theta0_deg"].value = value
+        assert (ax_th.get_ylim(), ax_u.get_ylim()) == shown, value
+    assert e.frames.full_draws == draws                      # every step blitted
+    low, high = ax_th.get_ylim()
+    assert low < 0 < 45 < high < 60                            # an eighth turn and a margin
+    assert ax_u.get_ylim()[0] <= -e.params["u_max"] and e.params["u_max"] <= ax_u.get_ylim()[1]
+    e.controls["theta0_deg"].value = -50.0                     # the other side, past an eighth turn
+    low, high = ax_th.get_ylim()
+    assert -100 < low < -90 and 0 < high < 10

@@ -8,7 +8,8 @@ A full draw happens again only when the background changes (limits, labels, size
 
 from __future__ import annotations
 
-import io
+import struct
+import zlib
 from operator import attrgetter
 
 import numpy as np
@@ -17,23 +18,24 @@ __all__ = ["FrameRenderer", "encode_png"]
 
 
 def encode_png(rgba, dpi: float) -> bytes:
-    """PNG bytes of an RGBA buffer, fast: zlib level 1 (half the time of the default level, for
-    a file about 15 % larger), without the alpha channel when every pixel is opaque."""
-    from PIL import Image   # matplotlib's own image library
+    """PNG bytes of an RGBA buffer, fast: rows unfiltered (a figure compresses about as well so; Pillow's
+    filter chosen row by row took 3/4 of the time), zlib level 1, no alpha channel when all is opaque."""
     pixels = np.asarray(rgba)
     if pixels[..., 3].min() == 255:
-        pixels = np.ascontiguousarray(pixels[..., :3])
-    buf = io.BytesIO()
-    Image.fromarray(pixels).save(buf, format="png", compress_level=1, dpi=(dpi, dpi))
-    return buf.getvalue()
+        pixels = pixels[..., :3]
+    height, width, channels = pixels.shape
+    rows = np.zeros((height, 1 + width * channels), dtype=np.uint8)   # each row: filter 0, its bytes
+    rows[:, 1:].reshape(height, width, channels)[...] = pixels
+    chunks = [(b"IHDR", struct.pack(">IIBBBBB", width, height, 8, 2 if channels == 3 else 6, 0, 0, 0)),
+              (b"pHYs", struct.pack(">IIB", *[round(dpi / 0.0254)] * 2, 1)),    # dots per metre
+              (b"IDAT", zlib.compress(rows, 1)), (b"IEND", b"")]
+    return b"\x89PNG\r\n\x1a\n" + b"".join(struct.pack(">I", len(data)) + kind + data
+                                         + struct.pack(">I", zlib.crc32(kind + data)) for kind, data in chunks)
 
 
 class FrameRenderer:
-    """Renders successive frames of one figure as PNG bytes, blitting where it can.
-
-    ``full_draws`` and ``blits`` count how the frames were made. `reset` makes the next
-    frame a full draw.
-    """
+    """Renders successive frames of one figure as PNG bytes, blitting where it can; ``full_draws``
+    and ``blits`` count how the frames were made, `reset` makes the next frame a full draw."""
 
     def __init__(self, fig):
         from matplotlib.backends.backend_agg import FigureCanvasAgg
@@ -42,7 +44,7 @@ class FrameRenderer:
         self.moving: set = set()
         self._animated: list = []
         self._background = None
-        self._key = self._layout = None
+        self._key = self._layout = self._meets_key = None    # _meets: artist -> meets its axes' data
         self.full_draws = self.blits = 0
 
     def reset(self) -> None:
@@ -62,8 +64,7 @@ class FrameRenderer:
     def render(self) -> None:
         """`frame` without the PNG: ``canvas.buffer_rgba()`` then shows the figure as it is now."""
         changed = {a for a in self._children() if a.stale} if self.full_draws else set()
-        new = changed - self.moving
-        self.moving |= changed
+        new, self.moving = changed - self.moving, self.moving | changed
         if self._background is None or new or self.state() != self._key:
             self._full_draw()
         else:
@@ -98,14 +99,27 @@ class FrameRenderer:
         draw each frame) when an axes or an axis is among them."""
         from matplotlib.axes import Axes
         from matplotlib.axis import Axis
-        renderer, out = self.canvas.get_renderer(), []
+        out, key = [], (self._text(), tuple(ax.get_position().bounds for ax in self.fig.axes))
+        if key != self._meets_key:
+            self._meets_key, self._meets = key, {}
         for parent in self._parents():
             order = sorted((a for a in parent.get_children() if a is not parent.patch), key=attrgetter("zorder"))
             first = next((i for i, a in enumerate(order) if a in self.moving), None)
             if first is not None:
-                out += [a for a in order[first:] if a in self.moving or parent is self.fig
-                        or a.get_window_extent(renderer).overlaps(parent.bbox.padded(3))]
+                out += [a for a in order[first:]
+                        if a in self.moving or parent is self.fig or self._meets_axes(a, parent)]
         return [] if any(isinstance(a, (Axes, Axis)) for a in out) else out
+
+    def _meets_axes(self, artist, ax) -> bool:
+        """Whether `artist` can be drawn on the data area of `ax`: measured once while the text and
+        layout stay (a legend's extent is a tenth of a full draw), unless placed in data coordinates."""
+        from matplotlib.spines import Spine
+        placed = [artist.get_transform(), getattr(artist, "get_offset_transform", artist.get_transform)()]
+        on_data = (artist.get_position()[0] == "data" if isinstance(artist, Spine)   # else on an edge
+                   else any(any(t.contains_branch_seperately(ax.transData)) for t in placed))
+        if artist not in self._meets or on_data:
+            self._meets[artist] = artist.get_window_extent(self.canvas.get_renderer()).overlaps(ax.bbox.padded(3))
+        return self._meets[artist]
 
     def _full_draw(self) -> None:
         for artist in self._animated:

@@ -24,6 +24,8 @@ __all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robo
 PLANNER_PLANT = dict(m=1.0, d=0.5, k=2.0)
 #: the largest target coordinate [m] and end speed [m/s] of the robot planner (sliders: 6 m, 2 m/s)
 ROBOT_RANGE = 1e6
+#: the robot planner's targets lie in [-TARGET_MAX, TARGET_MAX] along x1 and x2 [m] (its sliders)
+TARGET_MAX = 6.0
 #: height over width of the robot planner's path axes (x1 and x2 drawn on one scale)
 PATH_BOX = 0.75
 
@@ -68,17 +70,21 @@ def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0
 def planner_explorer() -> Explorer:
     """Sliders for the horizon T, the target and a mass error: y_d, u_d and the simulated y."""
     def draw(fig):
-        ax_y, ax_u = course_subplots(fig, 2, 1, sharex=True)
+        # one time axis for both, kept equal by update: not sharex, whose label placement measures
+        # the other axes' tick labels too, at each full draw (a step of T is one)
+        ax_y, ax_u = course_subplots(fig, 2, 1)
+        ax_y.tick_params(labelbottom=False)
         yd, = ax_y.plot([], [], color=PALETTE["black"], linestyle="--", label="planned y_d")
         y, = ax_y.plot([], [], label="simulated y", **curve_style(0))
         ax_y.set_ylabel("position y [m]")
-        ax_y.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
         ax_y.grid(True, alpha=0.4)
-        ud, = ax_u.plot([], [], label="u_d (2.30),\nheld at k y(T)\nafter T", **curve_style(1))
+        ud, = ax_u.plot([], [], label="u_d (2.30), held at k y(T) after T", **curve_style(1))
         ax_u.set_ylabel("force u [N]")
         ax_u.set_xlabel("time t [s]")
-        ax_u.legend(loc="upper left", bbox_to_anchor=(1.01, 1.0), fontsize="small")
         ax_u.grid(True, alpha=0.4)
+        # one legend below both axes, where it hides no curve (two beside them took a fifth of a
+        # full draw, and a step of T is a full draw: the time axis is [0, 2 T])
+        fig.legend(handles=[yd, y, ud], loc="outside lower center", ncols=3, fontsize="small")
         marks = [ax.axvline(0, color="0.5", linestyle=":") for ax in (ax_y, ax_u)]
         ax_y.set_title("planned and simulated position (dotted: the horizon T)")
         for line in (yd, y, ud):
@@ -92,7 +98,8 @@ def planner_explorer() -> Explorer:
         for line in h["marks"]:
             line.set_xdata([r["T"], r["T"]])
         rescale(h["ax_y"], h["ax_u"])
-        rescale(h["ax_u"], axis="x", fill=1.0)   # the shared time axis: exactly [0, 2 T] at rest
+        rescale(h["ax_u"], axis="x", fill=1.0)   # the time axis: exactly [0, 2 T] at rest
+        h["ax_y"].set_xlim(h["ax_u"].get_xlim())
 
     def readout(r):
         speed = np.abs(np.gradient(r["yd"], r["t"]))
@@ -258,12 +265,14 @@ def robot_planner_explorer() -> Explorer:
         rescale(h["ax_u"], axis="x", fill=1.0)   # the time axis: exactly [0, T] at rest
         # the data limits of the path axes from its points, start and target: not relim(), which
         # in newer matplotlib counts the arrow at a place that moves with the view, so the view
-        # would widen at every update
+        # would widen at every update; and the corners of the targets' square, so a step of a
+        # target keeps the plane's limits (a blitted frame, not a full draw) while the paths stay in it
         h["ax"].ignore_existing_data_limits = True
-        points = np.vstack([r["path"][:, :2], r["driven"][:, :2], [[0.0, 0.0], [tx, ty]]])
+        corners = TARGET_MAX * np.array([[-1.0, -1.0], [1.0, 1.0]])
+        points = np.vstack([r["path"][:, :2], r["driven"][:, :2], [[0.0, 0.0], [tx, ty]], corners])
         tip = _arrow_tip(points, tx, ty, th)
         h["ax"].update_datalim(np.vstack([points, tip]))
-        _rescale_off_ticks(h["ax"], "xy", relim=False)
+        _rescale_off_ticks(h["ax"], "xy", relim=False, fill=0.9)
         _same_scale(h["ax"])
 
     def readout(r):
@@ -273,8 +282,8 @@ def robot_planner_explorer() -> Explorer:
 
     return Explorer(
         title="Two-wheeled robot planner (2.94)-(2.102): flat outputs F = (x1, x2)",
-        controls=dict(x_T=slider(4.0, -6.0, 6.0, 0.5, "target x1 [m]"),
-                      y_T=slider(2.0, -6.0, 6.0, 0.5, "target x2 [m]"),
+        controls=dict(x_T=slider(4.0, -TARGET_MAX, TARGET_MAX, 0.5, "target x1 [m]"),
+                      y_T=slider(2.0, -TARGET_MAX, TARGET_MAX, 0.5, "target x2 [m]"),
                       heading_deg=slider(90.0, -180.0, 180.0, 15.0, "target heading [deg]"),
                       T=slider(6.0, 1.0, 20.0, 0.5, "horizon T [s]"),
                       speed=slider(1.0, -2.0, 2.0, 0.1, "end speed [m/s]")),

@@ -20,7 +20,7 @@ from ..systems import StateSpace
 from ..stability import format_poles
 from ..style import PALETTE, course_subplots, curve_style
 from ._base import Explorer, slider
-from .limits import rescale
+from .limits import Y_EDGE, rescale
 
 __all__ = ["pair_poles", "pole_placement_compute", "pole_placement_explorer", "upright_pendulum_compute",
            "upright_pendulum_explorer", "integral_action_compute", "integral_action_explorer"]
@@ -93,14 +93,15 @@ def pole_placement_explorer() -> Explorer:
         ax_p.axvline(0, color="0.5", lw=0.8)
         ax_p.set(xlim=(-12, 4), ylim=(-8, 8), xlabel="real part [1/s]", ylabel="imaginary part [rad/s]",
                  title="poles")
-        # below the figure, where it hides no pole whatever the sliders say
-        fig.legend(handles=[stable, ol, cl], loc="outside lower center", ncols=3, fontsize="small")
         xs = [ax_x.plot([], [], label=f"x{i + 1}", **curve_style(i))[0] for i in range(3)]
         ax_x.set(xlabel="time t [s]", ylabel="state x (dimensionless)", title="response from x0 = [1, 0, 0]")
-        ax_x.legend(loc="best", fontsize="small")
         u, = ax_u.plot([], [], color=PALETTE["black"], label="u = K x")
         ax_u.set(xlabel="time t [s]", ylabel="control effort u", title="control effort u(t)")
-        ax_u.legend(loc="best", fontsize="small")
+        # one legend below the figure, where it hides no pole or curve whatever the sliders say and
+        # is drawn with the background (a "best" place in the axes was searched at every frame)
+        # (filled column by column: the poles and u in the first row, the states in the second)
+        fig.legend(handles=[stable, xs[0], ol, xs[1], cl, xs[2], u], loc="outside lower center", ncols=4,
+                   fontsize="small")
         for ax in (ax_p, ax_x, ax_u):
             ax.grid(True, alpha=0.4)
         return dict(ax_p=ax_p, ax_x=ax_x, ax_u=ax_u, ol=ol, cl=cl, xs=xs, u=u)
@@ -193,6 +194,16 @@ def upright_pendulum_compute(theta0_deg: float = 30.0, pole: float = -2.0, u_max
     return out
 
 
+def _eighth_turns(degrees) -> tuple[float, float]:
+    """Limits of an angle axis for the angles `degrees` (with 0, upright): out to whole eighth
+    turns (45 deg; rounding noise of 1e-9 deg is not a turn), then by `Y_EDGE` of their span."""
+    low = 45.0 * np.floor(min(0.0, degrees.min()) / 45.0 + 1e-6)
+    high = 45.0 * np.ceil(max(0.0, degrees.max()) / 45.0 - 1e-6)
+    if high - low < 45.0:                    # upright all along: an eighth turn either way
+        low, high = -45.0, 45.0
+    return low - Y_EDGE * (high - low), high + Y_EDGE * (high - low)
+
+
 def upright_pendulum_explorer() -> Explorer:
     """Sliders for the initial angle and the pole speed: linear vs feedback-linearizing control."""
     def draw(fig):
@@ -217,8 +228,12 @@ def upright_pendulum_explorer() -> Explorer:
         h["ufl"].set_data(r["t"], r["u_fl"])
         for ax in (h["ax_th"], h["ax_u"]):
             ax.set_xlim(0, r["t"][-1])
-        rescale(h["ax_th"], min_span=2.0)     # degrees: started upright, it stays there
-        rescale(h["ax_u"], min_span=0.2)      # N m
+        # limits a step of the initial angle keeps (a blitted frame, not a full draw): the angles
+        # out to whole eighth turns, and the torque limit (the torques are clipped to it)
+        h["ax_th"].set_ylim(*_eighth_turns(np.r_[r["dev_linear"], r["dev_fl"]]))
+        h["ax_u"].relim()
+        h["ax_u"].update_datalim([[0.0, -r["u_max"]], [0.0, r["u_max"]]])
+        rescale(h["ax_u"], relim=False, fill=0.9)
 
     def readout(r):
         def told(name):
