@@ -136,9 +136,8 @@ class FrameRenderer:
         self.full_draws += 1
 
     def _draw_background(self) -> None:
-        """Draw the figure without the animated artists. Its layout measures every tick label and
-        title (half a full draw): done again only when that text may measure otherwise (its
-        strings, or the widest tick label's length), not when a step moves only the limits."""
+        """Draw the figure without the animated artists, laid out again (half a full draw) only when
+        its text may measure otherwise (strings, widest tick label), not when only limits move."""
         widest = [max(map(len, a.get_major_formatter().format_ticks(a.get_major_locator()())), default=0)
                   for ax in self.fig.axes for a in (ax.xaxis, ax.yaxis)]
         layout, engine = (self._text(), widest), self.fig.get_layout_engine()
@@ -152,7 +151,6 @@ class FrameRenderer:
             self.fig.set_layout_engine(engine)
 
     def _draw_animated(self) -> None:
-        renderer = self.canvas.get_renderer()
         for artist in self._animated:
-            artist.draw(renderer)
+            artist.draw(self.canvas.get_renderer())
             artist.stale = False
