@@ -13,12 +13,19 @@ from pathlib import Path
 import nbformat
 import pytest
 
+import coursekit.exercises as ex
 from coursekit.__main__ import main
 from coursekit.tools.cells import SOLUTION_TAG
+from coursekit.tools.chapters import chapter_modules
 from coursekit.tools.notebooks import default_notebook_dir, read_notebook
 from coursekit.tools.release import STUDENT_NOTE, build_release, student_edition
 
 NOTEBOOKS = sorted(default_notebook_dir().glob("*.ipynb"))
+
+
+def _chapter(path: Path) -> int:
+    """The chapter number of a notebook ``NN_name.ipynb``."""
+    return int(path.name.split("_", 1)[0])
 
 
 @pytest.fixture(scope="module")
@@ -34,7 +41,10 @@ def _has_tag(cell, tag):
 
 def test_release_writes_one_student_notebook_per_chapter(release):
     assert [p.name for p in release["paths"]] == [p.name for p in NOTEBOOKS]
-    assert len(NOTEBOOKS) == 4
+    # one notebook for each chapter of the course's one registry (coursekit/_chapters.py)
+    registry = sorted({int(m.__name__.rsplit("ch", 1)[1]) for package in ("explorers", "exercises")
+                       for m in chapter_modules(package)})
+    assert [_chapter(p) for p in NOTEBOOKS] == registry and registry[:4] == [1, 2, 3, 4]
 
 
 def test_no_solution_cell_remains_and_the_exercises_do(release):
@@ -95,7 +105,9 @@ def test_release_runs_top_to_bottom_without_errors(release):
 def test_every_unanswered_exercise_prints_not_yet(release):
     for path, nb in zip(release["paths"], release["executed"]):
         checks = [c for c in nb.cells if c.cell_type == "code" and "ex.check_" in c.source]
-        assert len(checks) >= 4, path.name
+        called = [re.search(r"\bex\.(check_\w+)\(", c.source).group(1) for c in checks]
+        # one answer cell for each exercise the chapter declares, in order
+        assert called == [e.check for e in ex.chapter_exercises(_chapter(path))], path.name
         for cell in checks:
             printed = "".join(o.get("text", "") for o in cell.outputs if o.output_type == "stream")
             assert "Not yet" in printed, f"{path.name}: {cell.source!r} printed {printed!r}"
