@@ -79,7 +79,10 @@ def _add_slides(commands) -> None:
 
 def _run_slides(args) -> int:
     if args.out is not None:
-        return _build_slides(args)
+        from .tools.slideshow import build_slides
+        index = build_slides(args.out, notebooks_dir=args.notebooks, verbose=True)
+        print(f"slides written to {index.parent}\nopen {index} in a browser (no network needed)")
+        return 0
     from .tools.slides import apply_slide_metadata
     changed = apply_slide_metadata(args.notebooks, write=not args.check)
     if args.check:
@@ -104,13 +107,6 @@ def _run_kernel_metadata(args) -> list:
         print(f"kernel metadata of Python {python} stored in {len(changed)} notebook(s)" if changed else
               f"kernel metadata already that of Python {python}")
     return changed
-
-
-def _build_slides(args) -> int:
-    from .tools.slideshow import build_slides
-    index = build_slides(args.out, notebooks_dir=args.notebooks, verbose=True)
-    print(f"slides written to {index.parent}\nopen {index} in a browser (no network needed)")
-    return 0
 
 
 def _add_colab(commands) -> None:
