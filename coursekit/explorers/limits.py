@@ -7,7 +7,8 @@ data padded to fill `fill` of the view, each end moved out to a multiple of a ro
 or 5 times a power of ten) no larger than the padding, so that stepping a slider redraws the
 limits only every few steps; a vertical axis then gains `Y_EDGE` of its span either way (no tick
 label on the frame's corner). While a control moves (moves less than `SETTLE_S` apart, drawn
-inside `moving`) the limits only grow, leaving the data `MOVING_FILL` of them.
+inside `moving`) the limits only grow, leaving the data `MOVING_FILL` of them and a vertical axis'
+data at least `Y_EDGE` / 2 of the span from the frame (a start on the frame is not seen).
 """
 
 from __future__ import annotations
@@ -98,13 +99,16 @@ def _fit(ax, name: str, min_span: float, fill: float) -> None:
     if not hi - lo > 1e-9 * max(abs(lo), abs(hi)):      # a constant: 5 % of it either way (or 0.05)
         half = 0.05 * (abs(lo) or 1.0)
         lo, hi = lo - half, hi + half
+    edge = Y_EDGE if name == "y" else 0.0
     if is_moving() and not getattr(ax, f"get_autoscale{name}_on")():
-        if view[0] <= lo and hi <= view[1]:
+        inside = edge / 2 * (view[1] - view[0])  # a curve's end on the frame is hard to see
+        if view[0] + inside <= lo and hi <= view[1] - inside:
             return                               # a hand moves a control: kept while the data fit
         pad = (hi - lo) * (1 / min(fill, MOVING_FILL) - 1) / 2
         low, high = min(lo - pad, view[0]), max(hi + pad, view[1])
+        low, high = min(low, lo - edge * (high - low)), max(high, hi + edge * (high - low))
     else:
-        low, high = _at_rest(lo, hi, fill, Y_EDGE if name == "y" else 0.0)
+        low, high = _at_rest(lo, hi, fill, edge)
     with np.errstate(all="ignore"):   # sticky edges: no room past them (a time axis' start)
         sticky = scale.transform([s for a in ax.get_children() for s in getattr(a.sticky_edges, name)])
     low = max([low, *(s for s in sticky if low < s <= lo)])
