@@ -262,6 +262,64 @@ def test_rescale_only_grows_the_limits_while_a_control_moves():
     assert ax.get_ylim() == pytest.approx((1.365, 2.135))
 
 
+def test_while_a_control_moves_data_near_the_frame_grow_the_limits():
+    """Data that still fit the view but reach within Y_EDGE / 2 of its frame are drawn with grown
+    limits: kept, a curve's end sat on the frame (the upright pendulum's start after a key step)."""
+    ax = Figure().subplots()
+    line, = ax.plot([0, 1], [0, 1])
+    rescale(ax)                                              # (-0.27, 1.27)
+    with limits.moving():
+        line.set_data([0, 1], [0, 1.25])                     # 1.3 % of the view below the top
+        rescale(ax)
+        low, high = ax.get_ylim()
+        assert low <= -0.27 and high - 1.25 >= limits.Y_EDGE * (high - low) - 1e-12   # only grown
+        grown = ax.get_ylim()
+        rescale(ax)                                          # the same data again: kept
+        assert ax.get_ylim() == grown
+
+
+def _first_samples(explorer) -> list[tuple[str, float]]:
+    """(curve, how far its first sample lies inside its axes' y limits, as a part of their span)
+    for every curve of the explorer's figure (in the axis' scale: decades on a log axis)."""
+    found = []
+    for k, ax in enumerate(explorer.fig.axes):
+        scale = ax.yaxis.get_transform()
+        low, high = np.sort(scale.transform(ax.get_ylim()))
+        for line in ax.get_lines():
+            if line.get_transform() != ax.transData:
+                continue                                 # a marker line in axes coordinates (axvline)
+            y = np.asarray(line.get_ydata(), dtype=float)
+            if y.size and np.isfinite(y[0]):
+                first = float(scale.transform([y[0]])[0])
+                found.append((f"axes {k} {line.get_label()!r}", min(first - low, high - first) / (high - low)))
+    return found
+
+
+@pytest.mark.parametrize("factory", FACTORIES, ids=lambda f: f.__name__)
+def test_a_key_step_right_after_another_keeps_each_curve_s_start_off_the_frame(factory):
+    """A key step less than SETTLE_S after the frame of the one before is drawn while `moving`
+    (the limits only grow): each curve's first sample stays Y_EDGE / 2 of the span inside the
+    vertical limits, or as far inside as the same settings' figure at rest puts it."""
+    e, near = factory(), []
+    for name, widget in _sliders(e).items():
+        default = widget.value
+        for start in sorted(set(_drag_values(widget, moves=8))):
+            for step in (widget.step, -widget.step):
+                if not widget.min <= start + step <= widget.max:
+                    continue
+                widget.value = start                     # no event loop: drawn at rest
+                with limits.moving():
+                    widget.value = type(default)(start + step)
+                moving = _first_samples(e)
+                e.refresh()                              # the same settings at rest
+                for (curve, inside), (_, at_rest) in zip(moving, _first_samples(e)):
+                    if inside < min(at_rest, limits.Y_EDGE / 2) - 1e-9:
+                        near.append(f"{name} {start:g} -> {start + step:g}: {curve} starts {inside:.1%} "
+                                    f"inside the limits (at rest {at_rest:.1%})")
+        widget.value = default
+    assert not near, "\n".join(near[:10])
+
+
 def test_an_explorer_in_a_kernel_grows_its_limits_during_a_drag_and_fits_them_once_at_rest():
     import asyncio
 

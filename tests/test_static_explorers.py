@@ -15,7 +15,6 @@ import pytest
 from PIL import Image
 
 from coursekit.explorers import Explorer, ch1, ch2, dropdown, int_slider, rescale, slider
-from coursekit.explorers import ch4
 from coursekit.tools import static_explorers as se
 from coursekit.tools.site_figures import drawn_for_the_column
 
@@ -59,7 +58,7 @@ def _pixels(image: bytes) -> np.ndarray:
     (slider(0.1, 0.01, 1.0, 0.01, "Ts [s]"), 21),
     (slider(-2.0, -6.0, -0.5, 0.25, "pole"), 8),
     (int_slider(2, 2, 4, "r"), 10),
-    (ch4._log_slider(ch4.KALMAN_TRUE_R, -6.0, 0.0, "log10 R (GPS)"), 12),   # a default off round numbers
+    (slider(-0.30103, -4.00103, 2.99897, 0.1, "log10 Q"), 12),   # a grid off round numbers
 ])
 def test_slider_values_hold_the_default_both_ends_and_only_values_the_slider_can_hold(widget, count):
     values = se.slider_values(widget, count)

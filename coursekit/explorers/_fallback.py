@@ -1,10 +1,10 @@
 """What an explorer shows in a notebook reopened after a save: its figure, not a widget error.
 
-A saved notebook keeps a widget's view, not its state, and ipywidgets' renderer then shows "model
-not found" and never another type of the same output (saving widget state does not help without
-a kernel: jupyterlab/jupyterlab#15361). So an explorer shown in a kernel first publishes an HTML
-output with its figure, text alternative and readout; its style sheet shows either it or the live
-widget after it. The static builds (website, slides) drop it (`is_fallback`).
+A saved notebook keeps a widget's view, not its state; in a trusted notebook ipywidgets' renderer
+then shows "model not found", never the PNG of the same output (state saved by JupyterLab's user
+setting would show controls with no kernel behind them). So an explorer shown in a kernel first
+publishes an HTML output with its figure, text alternative and readout; its style sheet shows either
+it or the live widget after it. The static builds (website, slides) drop it (`is_fallback`).
 """
 
 from __future__ import annotations

@@ -20,9 +20,10 @@ from .limits import rescale
 
 __all__ = ["EULER_EXAMPLES", "euler_compute", "euler_explorer", "msd_compute", "msd_explorer"]
 
-#: The systems the Euler explorer offers: (system, x0, t_end, state unit).
+#: The systems the Euler explorer offers: (system, x0, t_end, state unit; "" for a dimensionless
+#: state, shown with no unit: a unit "-" reads as a minus sign).
 EULER_EXAMPLES = {
-    "first order (1.12)": (StateSpace([[-3.0]], name="y' = -3 y"), [6.0], 3.0, "-"),
+    "first order (1.12)": (StateSpace([[-3.0]], name="y' = -3 y"), [6.0], 3.0, ""),
     "mass-spring-damper (1.57)": (models.mass_spring_damper(m=1.0, d=0.5, k=2.0), [1.0, 0.0], 15.0, "m"),
 }
 
@@ -96,13 +97,15 @@ def euler_explorer() -> Explorer:
         # a little room before t = 0 keeps the first time label clear of the error axis' lowest one
         h["ax"].set_xlim(-0.02 * r["t"][-1], r["t"][-1])
         h["ax"].set_ylim(r["x"].min() - 0.5 * span, r["x"].max() + 0.5 * span)
-        h["ax"].set_ylabel(f"x1 [{r['unit']}]")
-        h["ax_err"].set_ylabel(f"|error| [{r['unit']}]")
+        unit = f" [{r['unit']}]" if r["unit"] else ""
+        h["ax"].set_ylabel(f"x1{unit}")
+        h["ax_err"].set_ylabel(f"|error|{unit}")
         rescale(h["ax_err"])
 
     def readout(r):
         verdict = "< 1: stable" if r["stable"] else ">= 1: UNSTABLE"
-        return (f"{r['example']}, Ts = {r['Ts']:.3g} s: largest error {r['max_error']:.2g} {r['unit']}\n"
+        error = f"{r['max_error']:.2g} {r['unit']}".rstrip()
+        return (f"{r['example']}, Ts = {r['Ts']:.3g} s: largest error {error}\n"
                 f"max |eig(I + Ts A)| = {r['rho']:.3f} {verdict} (Euler is stable for Ts < {r['Ts_max']:.3g} s)")
 
     return Explorer(

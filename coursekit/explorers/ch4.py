@@ -128,8 +128,9 @@ def observer_noise_explorer() -> Explorer:
 
 
 #: The true noise intensities of the Kalman explorer's data: force noise on the
-#: velocity [(m/s)^2/s] and GPS noise [m^2 s] (std 0.1 m per sample at dt = 0.01 s).
-KALMAN_TRUE_Q, KALMAN_TRUE_R = 0.5, 1e-4
+#: velocity [(m/s)^2/s] and GPS noise [m^2 s] (std 0.1 m per sample at dt = 0.01 s). Both are
+#: powers of ten, so that the log10 sliders start at them on a grid of round values.
+KALMAN_TRUE_Q, KALMAN_TRUE_R = 1.0, 1e-4
 
 
 def _kalman_run(sys, t, record, x_true, Q, R):
@@ -184,15 +185,6 @@ def _exponent(value, name: str) -> float:
     return value
 
 
-def _log_slider(true_value: float, low: float, high: float, description: str, step: float = 0.1):
-    """A slider for log10 of a noise intensity, starting at the true one: its range, about
-    [low, high], is moved so that the true value is one of its steps (a browser's slider moves
-    a value between steps to the nearest one, and the figure would start at a wrong intensity)."""
-    start = float(np.log10(true_value))
-    below, above = np.floor((start - low) / step + 1e-9), np.floor((high - start) / step + 1e-9)
-    return slider(start, start - below * step, start + above * step, step, description)
-
-
 def kalman_tuning_explorer() -> Explorer:
     """Sliders for log10 Q and log10 R of a Kalman observer on the same noisy data."""
     def readout(r):
@@ -201,6 +193,7 @@ def kalman_tuning_explorer() -> Explorer:
 
     return Explorer(
         title="Kalman filter tuning (4.87)-(4.88): only Q/R matters",
-        controls=dict(log10_q=_log_slider(KALMAN_TRUE_Q, -4.0, 3.0, "log10 Q (velocity)"),
-                      log10_r=_log_slider(KALMAN_TRUE_R, -6.0, 0.0, "log10 R (GPS)")),
+        # both start at the true intensities, powers of ten: on the sliders' grids of round values
+        controls=dict(log10_q=slider(float(np.log10(KALMAN_TRUE_Q)), -4.0, 3.0, 0.1, "log10 Q (velocity)"),
+                      log10_r=slider(float(np.log10(KALMAN_TRUE_R)), -6.0, 0.0, 0.1, "log10 R (GPS)")),
         compute=kalman_tuning_compute, draw=_two_state_axes, update=_set_two_state, readout=readout, figsize=(8, 6))

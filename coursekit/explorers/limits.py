@@ -1,13 +1,12 @@
-"""The explorers' limit policy: `rescale` fits an axes' view to its data; `moving` says a hand
-moves a control.
+"""The explorers' limit policy: `rescale` fits an axes' view to its data; `moving` says a hand moves a control.
 
 At rest the limits depend on the data alone, so a setting's figure is the same after a drag,
 after key steps, fresh, and in the website's frames (`coursekit.tools.static_explorers`): the
 data padded to fill `fill` of the view, each end moved out to a multiple of a round step (1, 2
 or 5 times a power of ten) no larger than the padding, so that stepping a slider redraws the
 limits only every few steps; a vertical axis then gains `Y_EDGE` of its span either way (no tick
-label on the frame's corner). While a control moves (moves less than `SETTLE_S` apart, drawn
-inside `moving`) the limits only grow, leaving the data `MOVING_FILL` of them.
+label on the frame's corner). While a control moves (drawn inside `moving`) the limits only grow,
+leaving the data `MOVING_FILL` of them and `Y_EDGE` / 2 of a vertical span off the frame.
 """
 
 from __future__ import annotations
@@ -96,15 +95,16 @@ def _fit(ax, name: str, min_span: float, fill: float) -> None:
     if hi - lo < min_span:
         lo, hi = (lo + hi - min_span) / 2, (lo + hi + min_span) / 2
     if not hi - lo > 1e-9 * max(abs(lo), abs(hi)):      # a constant: 5 % of it either way (or 0.05)
-        half = 0.05 * (abs(lo) or 1.0)
-        lo, hi = lo - half, hi + half
+        lo, hi = lo - 0.05 * (abs(lo) or 1.0), hi + 0.05 * (abs(lo) or 1.0)
+    edge = Y_EDGE if name == "y" else 0.0
     if is_moving() and not getattr(ax, f"get_autoscale{name}_on")():
-        if view[0] <= lo and hi <= view[1]:
+        if view[0] + edge / 2 * np.ptp(view) <= lo and hi <= view[1] - edge / 2 * np.ptp(view):
             return                               # a hand moves a control: kept while the data fit
         pad = (hi - lo) * (1 / min(fill, MOVING_FILL) - 1) / 2
-        low, high = min(lo - pad, view[0]), max(hi + pad, view[1])
+        span = max(hi + pad, view[1]) - min(lo - pad, view[0])
+        low, high = min(lo - pad, view[0], lo - edge * span), max(hi + pad, view[1], hi + edge * span)
     else:
-        low, high = _at_rest(lo, hi, fill, Y_EDGE if name == "y" else 0.0)
+        low, high = _at_rest(lo, hi, fill, edge)
     with np.errstate(all="ignore"):   # sticky edges: no room past them (a time axis' start)
         sticky = scale.transform([s for a in ax.get_children() for s in getattr(a.sticky_edges, name)])
     low = max([low, *(s for s in sticky if low < s <= lo)])
