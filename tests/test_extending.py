@@ -79,7 +79,9 @@ def test_the_checks_every_chapter_must_pass_pass_for_the_new_chapter(extended, a
     """The checks the doc names, on chapter 5 (the slides without the browser, which built and
     opened every chapter's slides again: the README's whole command on a copy made by
     tests/extending_doc.py runs them)."""
-    result = run_in([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *args], extended, timeout=900)
+    # -n 0: in one process (this run's own workers already take the cores)
+    result = run_in([sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-n", "0", *args], extended,
+                    timeout=900)
     assert result.returncode == 0, result.stdout[-5000:]
     assert re.search(r"\b\d+ passed", result.stdout), result.stdout[-2000:]
 
