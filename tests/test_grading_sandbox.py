@@ -279,7 +279,10 @@ def test_a_grader_stopped_midway_leaves_nothing_running(tmp_path):
                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     deadline = time.monotonic() + 90
     while not any("ipykernel_launcher" in p for p in _processes_naming(str(scratch))):
-        assert time.monotonic() < deadline and grader.poll() is None, "the kernel never started"
+        grades = tmp_path / "out" / "grades.csv"
+        assert grader.poll() is None, f"the grader ended (exit {grader.returncode}) before its kernel was seen: " \
+            + (grades.read_text(encoding="utf-8") if grades.exists() else "no grades written")
+        assert time.monotonic() < deadline, "the kernel never started"
         time.sleep(0.2)
     grader.kill()
     grader.wait()
