@@ -266,12 +266,30 @@ def _processes_naming(text: str) -> list[str]:
 
 
 @needs_bwrap
+def test_a_long_temp_folder_leaves_room_for_the_kernel_s_sockets(tmp_path):
+    """A sandboxed kernel talks over Unix sockets in the grader's temp folder: under a temp folder
+    whose path leaves them no room (108 bytes at most), the grader puts its own in /tmp."""
+    import subprocess
+    folder, scratch = tmp_path / "subs", tmp_path / ("t" * 70)
+    folder.mkdir(), scratch.mkdir()
+    _write(folder, "quick.ipynb", [new_code_cell("x = 1")], {})
+    subprocess.run([sys.executable, "-m", "coursekit", "grade", "--chapter", "1", str(folder), "--out",
+                    str(tmp_path / "out"), "--timeout", "60", "--jobs", "1"], env={**os.environ, "TMPDIR": str(scratch)},
+                   check=True, capture_output=True)
+    rows = list(csv.DictReader((tmp_path / "out" / "grades.csv").open(encoding="utf-8")))
+    assert [row["status"] for row in rows] == ["ok"], rows
+
+
+@needs_bwrap
 def test_a_grader_stopped_midway_leaves_nothing_running(tmp_path):
     """Ctrl-C (here SIGKILL) on the grader ends its runners and their sandboxed kernels too."""
+    import shutil
     import subprocess
+    import tempfile
     import time
-    folder, scratch = tmp_path / "subs", tmp_path / "scratch"
-    folder.mkdir(), scratch.mkdir()
+    # a short temp folder: the grader's own goes into it (not into /tmp), so its processes name it
+    folder, scratch = tmp_path / "subs", Path(tempfile.mkdtemp(prefix="ck-stop-"))
+    folder.mkdir()
     _write(folder, "sleeper.ipynb", [new_code_cell("import time\nwhile True:\n    time.sleep(0.1)")], {})
     grader = subprocess.Popen([sys.executable, "-m", "coursekit", "grade", "--chapter", "1", str(folder), "--out",
                                str(tmp_path / "out"), "--timeout", "120", "--jobs", "1"],
@@ -289,4 +307,6 @@ def test_a_grader_stopped_midway_leaves_nothing_running(tmp_path):
     deadline = time.monotonic() + 15
     while _processes_naming(str(scratch)) and time.monotonic() < deadline:
         time.sleep(0.2)
-    assert _processes_naming(str(scratch)) == []
+    left = _processes_naming(str(scratch))
+    shutil.rmtree(scratch, ignore_errors=True)
+    assert left == []

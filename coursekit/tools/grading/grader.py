@@ -225,6 +225,13 @@ def _run_notebook(nb, number: int, run: _Run, checks: list[str]) -> tuple[str, s
     return outcome["status"], outcome["detail"], outcome["errors"], last
 
 
+def _temp_root() -> str | None:
+    """Where the grader's temp folder goes: the user's temp folder (None), unless a sandboxed kernel's
+    IPC sockets in it ("/coursekit-grade-XXXXXXXX/N/box/ipc-NNNNN", about 50 bytes more) would pass a
+    Unix socket's 107 bytes ("File name too long": the kernel dies); then /tmp."""
+    return None if len(tempfile.gettempdir()) + 50 <= 107 else "/tmp"
+
+
 def _execute(job_file: Path, job: dict, env: dict) -> dict:
     """Run the notebook's runner; its outcome, accepted only in the runner's own form."""
     job_file.write_text(json.dumps(job), encoding="utf-8")
@@ -437,7 +444,7 @@ def grade(submissions, out, *, chapter: int, timeout: float = 300, memory: int |
     memory = parse_memory(memory) if isinstance(memory, str) else int(memory)
     paths = _submission_paths(submissions)
     # a notebook may leave files it made unremovable: that must not cost it its grades
-    with tempfile.TemporaryDirectory(prefix="coursekit-grade-", ignore_cleanup_errors=True) as folder:
+    with tempfile.TemporaryDirectory(prefix="coursekit-grade-", dir=_temp_root(), ignore_cleanup_errors=True) as folder:
         hidden = tuple(Path(p).resolve() for p in (submissions, out, folder, Path.cwd()))
         run = _Run(chapter, exercises, float(timeout), memory, Path(folder), hidden, bool(sandbox))
         if run.sandboxed:

@@ -86,11 +86,8 @@ def _python_folders(package_root: Path) -> list[Path]:
         if path.is_dir() and not any(path == folder or path in folder.parents for folder in private):
             folders.add(path)
     folders.add(package_root / "coursekit")
-    return sorted(f for f in folders if not _inside(f.parent, folders) and not _inside(f, _system_roots()))
-
-
-def _system_roots() -> list[Path]:
-    return [Path("/") / name for name in _SYSTEM]
+    system = [Path("/") / name for name in _SYSTEM]     # bound whole already
+    return sorted(f for f in folders if not _inside(f.parent, folders) and not _inside(f, system))
 
 
 @dataclass(frozen=True)
