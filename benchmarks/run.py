@@ -311,16 +311,32 @@ ABOUT = {
 }
 
 
-def write_docs(path: Path, command: str, report: list[str]) -> None:
-    """docs/performance.md: how the numbers were made, then the tables of this run."""
+def write_docs(path: Path, command: str, report: list[list[str]]) -> None:
+    """docs/performance.md: each section of this run (`report`: its lines, heading first) in place
+    of the file's section of the same title, saying the command and date that measured it; the
+    sections this run did not measure stay as they were."""
     import datetime
+
+    def title(heading: str) -> str:
+        return heading.split(" (median of")[0]
+
+    kept: dict = {}
+    if path.exists():
+        for chunk in path.read_text(encoding="utf-8").split("\n## ")[1:]:
+            lines = ("## " + chunk).rstrip("\n").split("\n")
+            kept[title(lines[0])] = lines + [""]
+    stamp = (f"Measured by `{command}` on {datetime.date.today().isoformat()}, {os.cpu_count()} cores, "
+             f"Python {sys.version.split()[0]}, numpy {np.__version__}.")
+    for lines in report:
+        kept[title(lines[0])] = [lines[0], "", stamp, *lines[1:]]
     head = ["# Performance", "",
-            "Written by `benchmarks/run.py` (do not edit by hand): run it again to refresh every table.",
-            f"This run: `{command}` on {datetime.date.today().isoformat()}, {os.cpu_count()} cores. "
+            "Written by `benchmarks/run.py` (do not edit by hand): `--docs` writes again the sections its "
+            "run measured, each saying the command and date that measured it, and keeps the others. "
             "Competitors are timed in interleaved repetitions and reported as medians; speed is judged "
             "by the ratios, which hold across machines better than the times.", ""]
     path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text("\n".join(head + report) + "\n", encoding="utf-8")
+    path.write_text("\n".join(head + [line for lines in kept.values() for line in lines]).rstrip("\n") + "\n",
+                    encoding="utf-8")
 
 
 def _student_submissions(folder: Path, count: int) -> Path:
@@ -444,12 +460,12 @@ def main() -> None:
     if args.builds_only:
         sections = [builds_section]
     print(f"coursekit benchmarks, Python {sys.version.split()[0]}, numpy {np.__version__}\n")
-    report = [f"Python {sys.version.split()[0]}, numpy {np.__version__}.", ""]
+    report = []
     for title, func, reps in sections:
         lines = [f"## {title} (median of {reps})", "", ABOUT[title.split(":")[0].split(" (")[0]], "",
                  *func(reps), ""]
         print("\n".join(lines))
-        report += lines
+        report.append(lines)
     if args.docs:
         shown = [a for a in sys.argv[1:] if a not in (args.screenshots and str(args.screenshots), "--screenshots")]
         write_docs(ROOT / "docs" / "performance.md", "python benchmarks/run.py " + " ".join(shown), report)
