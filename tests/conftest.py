@@ -23,14 +23,14 @@ def sorted_eig(values):
 
 
 @pytest.fixture(scope="session")
-def executed_chapters(tmp_path_factory):
+def executed_chapters(tmp_path_factory, worker_id):
     """The chapters executed once per session for the tests that read them (tests/executed_chapters.py)."""
     from executed_chapters import ExecutedChapters
-    return ExecutedChapters(tmp_path_factory)
+    return ExecutedChapters(tmp_path_factory, worker_id)
 
 
 @pytest.fixture(scope="session")
-def course_builds(tmp_path_factory, executed_chapters):
+def course_builds(tmp_path_factory, worker_id, executed_chapters):
     """The website and the slides built once per session for the tests that read them (tests/course_builds.py)."""
     from course_builds import CourseBuilds
-    return CourseBuilds(tmp_path_factory, executed_chapters)
+    return CourseBuilds(tmp_path_factory, worker_id, executed_chapters)

@@ -30,8 +30,8 @@ class CourseBuilds:
     """The website and the slides of the course, each built once per run, when a test first asks
     for it, into the run's shared folder (tests/run_once.py)."""
 
-    def __init__(self, tmp_path_factory, executed_chapters: ExecutedChapters):
-        self._folder = shared_folder(tmp_path_factory) / "builds"
+    def __init__(self, tmp_path_factory, worker_id: str, executed_chapters: ExecutedChapters):
+        self._folder = shared_folder(tmp_path_factory, worker_id) / "builds"
         self._executed = executed_chapters
 
     def site(self) -> dict[str, Path]:

@@ -49,8 +49,8 @@ class ExecutedChapters:
     executed notebooks; `has_instructor(name)` says whether that chapter's is there, without
     executing it. A chapter that failed fails every test that asks for it, with the message."""
 
-    def __init__(self, tmp_path_factory):
-        self._folder = shared_folder(tmp_path_factory) / "executed"
+    def __init__(self, tmp_path_factory, worker_id: str):
+        self._folder = shared_folder(tmp_path_factory, worker_id) / "executed"
         self._read = {}     # ("instructor", file name) or ("student", "") -> what was read
 
     def instructor(self, name: str):

@@ -10,7 +10,6 @@ asks for it fails with its message.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 from typing import Callable
 
@@ -22,11 +21,12 @@ __all__ = ["shared_folder", "once", "made"]
 _DONE, _FAILED = ".done", ".failed"
 
 
-def shared_folder(tmp_path_factory) -> Path:
-    """The temp folder every worker of this run shares: under xdist (which names the worker in
-    ``PYTEST_XDIST_WORKER``) the parent of the workers' own, else the session's."""
+def shared_folder(tmp_path_factory, worker_id: str) -> Path:
+    """The temp folder every worker of this run shares: for an xdist worker (`worker_id`, xdist's
+    fixture, is not "master") the parent of the workers' own, else the session's. (Not the
+    environment's PYTEST_XDIST_WORKER: a pytest started by a worker's test inherits it.)"""
     base = tmp_path_factory.getbasetemp()
-    return base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base
+    return base.parent if worker_id != "master" else base
 
 
 def made(folder: Path) -> bool:

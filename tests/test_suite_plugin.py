@@ -88,8 +88,8 @@ def _build(folder):
     folder.mkdir()
 
 @pytest.fixture(scope="session")
-def executed_chapters(tmp_path_factory):
-    return once(shared_folder(tmp_path_factory) / "chapters", _build)
+def executed_chapters(tmp_path_factory, worker_id):
+    return once(shared_folder(tmp_path_factory, worker_id) / "chapters", _build)
 """
 
 _MODULE = """
