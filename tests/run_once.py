@@ -31,7 +31,7 @@ def shared_folder(tmp_path_factory, worker_id: str) -> Path:
 
 def made(folder: Path) -> bool:
     """Whether a worker of this run has made `folder` with `once` (without waiting for one that is making it)."""
-    return Path(str(folder) + _DONE).exists()
+    return folder.with_name(folder.name + _DONE).exists()
 
 
 def once(folder: Path, build: Callable[[Path], None]) -> Path:
@@ -39,8 +39,8 @@ def once(folder: Path, build: Callable[[Path], None]) -> Path:
     making it: then this one waits). Fails the asking test, with the first attempt's message,
     when that build raised."""
     folder.parent.mkdir(parents=True, exist_ok=True)
-    with FileLock(str(folder) + ".lock"):
-        done, failed = Path(str(folder) + _DONE), Path(str(folder) + _FAILED)
+    with FileLock(folder.with_name(folder.name + ".lock")):
+        done, failed = folder.with_name(folder.name + _DONE), folder.with_name(folder.name + _FAILED)
         if failed.exists():
             pytest.fail(failed.read_text(encoding="utf-8"))
         if not done.exists():
