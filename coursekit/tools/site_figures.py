@@ -48,11 +48,13 @@ def _shown_texts(artist):
         yield from _shown_texts(child)
 
 
-def smallest_text_pt(fig) -> float | None:
+def smallest_text_pt(fig, *, drawn: bool = False) -> float | None:
     """The font size in points of the smallest text `fig` shows (tick labels, legends, titles,
     annotations, ...), None for a figure without text. Lays the figure out (draws it without
-    rendering), so that its tick labels exist."""
-    fig.draw_without_rendering()
+    rendering), so that its tick labels exist, unless `drawn` says it was just drawn as it is
+    (a second layout and draw would find the same texts: an explorer's frame, 40 % of its cost)."""
+    if not drawn:
+        fig.draw_without_rendering()
     return min((text.get_fontsize() for text in _shown_texts(fig)), default=None)
 
 

@@ -184,8 +184,9 @@ def _webp(rgba) -> bytes:
 
 
 def _smallest_text_pt(fig) -> float | None:
+    """Of a frame just rendered with its layout settled (`render_settled`): no second draw."""
     from .site_figures import smallest_text_pt
-    return smallest_text_pt(fig)
+    return smallest_text_pt(fig, drawn=True)
 
 
 def _move(explorer, settings: dict, defaults: dict, view) -> None:
