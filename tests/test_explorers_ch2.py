@@ -100,18 +100,18 @@ def test_the_robot_planner_s_path_is_on_one_scale_with_limits_a_draw_keeps_and_l
     from coursekit.tools.site_figures import drawn_for_the_column
     e = ch2.robot_planner_explorer()
     ax = e.handles["ax"]
-    for settings in ({}, {"x_T": -6.0, "y_T": 6.0}, {"T": 20.0, "speed": 2.0}, {"heading_deg": -180.0}):
-        for name, value in settings.items():
+    for moved in ({}, {"x_T": -6.0, "y_T": 6.0}, {"T": 20.0, "speed": 2.0}, {"heading_deg": -180.0}):
+        for name, value in moved.items():
             e.controls[name].value = value
         limits = ax.get_xlim(), ax.get_ylim()
         e.frames.reset()
         e.frames.frame()                                          # a full draw
-        assert (ax.get_xlim(), ax.get_ylim()) == limits, settings
+        assert (ax.get_xlim(), ax.get_ylim()) == limits, moved
         box = ax.get_window_extent()
         metre_x, metre_y = box.width / np.ptp(limits[0]), box.height / np.ptp(limits[1])
-        assert metre_x == pytest.approx(metre_y, rel=1e-3), settings
+        assert metre_x == pytest.approx(metre_y, rel=1e-3), moved
         with drawn_for_the_column(e.fig, e.natural_dpi):
-            assert text_problems(e.fig) == [], settings
+            assert text_problems(e.fig) == [], moved
 
 
 def test_the_robot_planner_s_plane_holds_every_target_so_a_target_step_keeps_its_limits():
