@@ -9,8 +9,9 @@ of a folder of chapter-1 submissions:
 * ``tampered``: the feedback helpers patched so that the real checks praise
   wrong answers: 0 (the answers are checked again by the grader);
 * ``loop``, ``exit``, ``memory``, ``invalid``, ``chapter2``, ``untitled3``, ``files``: an
-  endless loop, ``os._exit(3)``, a 50 GiB allocation, invalid JSON, another
-  chapter's notebook and cells that write and delete files around them: each
+  endless loop (one that sleeps: the grader's limit is a time, and a spinning loop would only
+  take a core from the rest of the test run for the limit's 45 s, twice), ``os._exit(3)``, a
+  50 GiB allocation, invalid JSON, another chapter's notebook and cells that write and delete files around them: each
   gets its status, and the answers given before (and after) the accident count.
 
 The other notebooks hold the exercise section only (not the whole chapter),
@@ -55,7 +56,7 @@ def _submissions(folder: Path) -> None:
         "student": edition.cells,                       # the whole edition, untouched
         "patched": [heading, *setup, patch, *student[2:]],
         "tampered": [heading, *setup, tamper],
-        "loop": [heading, *setup, *answer(right, CHECKS[0]), new_code_cell("while True:\n    pass"),
+        "loop": [heading, *setup, *answer(right, CHECKS[0]), new_code_cell("import time\nwhile True:\n    time.sleep(0.05)"),
                  *answer(right, CHECKS[1])],
         "exit": [heading, *setup, *answer(right, CHECKS[1]), new_code_cell("import os\nos._exit(3)")],
         "memory": [heading, *setup, *answer(right, CHECKS[3]),
