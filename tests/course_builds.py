@@ -5,8 +5,8 @@
   ``python -m coursekit site --out DIR --student-out DIR`` builds them (tests/test_site_browser.py
   opens them in Chromium; tests/test_build_structure.py compares what they show with its record);
 * `slides`: the slides of the whole course, built by `build_slides` (what ``python -m coursekit
-  slides`` calls), the chapters the session executed already replayed rather than executed again
-  (its `execute` argument, `executed_chapters.replaying`; tests/test_slides.py,
+  slides`` calls), each chapter replayed from the session's one execution of it rather than
+  executed again (its `execute` argument, `executed_chapters.replaying`; tests/test_slides.py,
   tests/test_build_structure.py).
 
 Each is built once per run, when a test first asks for it, however many xdist workers ask; the

@@ -5,8 +5,10 @@ outputs (the session fixture ``executed_chapters`` of tests/conftest.py, an `Exe
   test first asks for it, after a first cell (`PRELUDE`) that gives every figure the slides'
   description (``slideshow.DESCRIBE_FIGURES``) and every figure and explorer its report of
   `figure_checks` (`notebook_figures.PRELUDE`). The figure-style test reads the reports; the
-  slides of the whole course (tests/test_slides.py) take, by `replay_into`, the chapters executed
-  already (in a full run, all of them) and execute only the others.
+  slides of the whole course (tests/test_slides.py) take every chapter from here, by
+  `replay_into`, executing none themselves (a chapter no worker executed yet is executed here
+  first: the slides' build once ran the chapters the figure-style test had not reached yet,
+  which that test then executed a second time).
 * the student edition: as ``python -m coursekit release`` writes it, executed as it is
   (tests/test_release.py).
 
@@ -29,7 +31,7 @@ from coursekit.tools.notebooks import default_notebook_dir, execute_all, read_no
 from coursekit.tools.slideshow import DESCRIBE_FIGURES
 from kernels import this_python_kernel
 from notebook_figures import PRELUDE as FIGURE_CHECKS, REPORT
-from run_once import made, once, shared_folder
+from run_once import once, shared_folder
 
 __all__ = ["PRELUDE", "Executed", "ExecutedChapters", "replay_into", "replaying"]
 
@@ -46,8 +48,7 @@ class Executed:
 class ExecutedChapters:
     """The chapters this run executed, each once however many xdist workers ask (tests/run_once.py):
     `instructor(name)` and `student()` execute what no worker executed yet and hand out the
-    executed notebooks; `has_instructor(name)` says whether that chapter's is there, without
-    executing it. A chapter that failed fails every test that asks for it, with the message."""
+    executed notebooks. A chapter that failed fails every test that asks for it, with the message."""
 
     def __init__(self, tmp_path_factory, worker_id: str):
         self._folder = shared_folder(tmp_path_factory, worker_id) / "executed"
@@ -60,9 +61,6 @@ class ExecutedChapters:
             folder = once(self._folder / "instructor" / name, lambda out: _execute_instructor(name, out))
             self._read[key] = read_notebook(folder / name)
         return self._read[key]
-
-    def has_instructor(self, name: str) -> bool:
-        return ("instructor", name) in self._read or made(self._folder / "instructor" / name)
 
     def student(self) -> Executed:
         if ("student", "") not in self._read:
@@ -121,19 +119,14 @@ def replay_into(nb, executed, *, drop: tuple[str, ...] = ()) -> None:
 
 
 def replaying(executed_chapters: ExecutedChapters) -> Callable:
-    """An `execute_all` for ``build_slides(execute=...)`` that executes only the chapters
-    `executed_chapters` has not executed: the others take the outputs of the shared copies
-    (`replay_into`, without the figure checks' reports), which must match them cell by cell."""
+    """An `execute_all` for ``build_slides(execute=...)`` of the course's own notebooks that gives
+    each chapter the outputs of its shared copy (`replay_into`, without the figure checks'
+    reports), which must match it cell by cell: executed once per run, by whichever worker asks
+    first (``ExecutedChapters.instructor``). The `options` of `execute_all` are not needed."""
     def execute(notebooks: list, paths: list[Path], *, prelude: str = "", **options) -> None:
-        rest = []
         for nb, path in zip(notebooks, paths):
-            if executed_chapters.has_instructor(path.name):
-                nb.cells.insert(0, nbformat.v4.new_code_cell(prelude))
-                replay_into(nb, executed_chapters.instructor(path.name), drop=(REPORT,))
-                nb.cells.pop(0)
-            else:
-                rest.append((nb, path))
-        if rest:
-            execute_all([nb for nb, _ in rest], [path for _, path in rest], prelude=prelude, **options)
+            nb.cells.insert(0, nbformat.v4.new_code_cell(prelude))
+            replay_into(nb, executed_chapters.instructor(path.name), drop=(REPORT,))
+            nb.cells.pop(0)
 
     return execute

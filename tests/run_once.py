@@ -16,7 +16,7 @@ from typing import Callable
 import pytest
 from filelock import FileLock
 
-__all__ = ["shared_folder", "once", "made"]
+__all__ = ["shared_folder", "once"]
 
 _DONE, _FAILED = ".done", ".failed"
 
@@ -27,11 +27,6 @@ def shared_folder(tmp_path_factory, worker_id: str) -> Path:
     environment's PYTEST_XDIST_WORKER: a pytest started by a worker's test inherits it.)"""
     base = tmp_path_factory.getbasetemp()
     return base.parent if worker_id != "master" else base
-
-
-def made(folder: Path) -> bool:
-    """Whether a worker of this run has made `folder` with `once` (without waiting for one that is making it)."""
-    return folder.with_name(folder.name + _DONE).exists()
 
 
 def once(folder: Path, build: Callable[[Path], None]) -> Path:

@@ -276,9 +276,9 @@ def _expected_slides(path: Path) -> tuple[int, int]:
 @pytest.fixture(scope="module")
 def course(course_builds):
     """The slides of the whole course, from the session's one build (tests/course_builds.py), with
-    the command an instructor types; the chapters this session executed already are replayed
-    there (tests/executed_chapters.py: the same notebooks, run after the same first cell and the
-    figure checks'), which they must match cell by cell, and the others are executed."""
+    the command an instructor types; every chapter is replayed there from the session's one
+    execution of it (tests/executed_chapters.py: the same notebooks, run after the same first cell
+    and the figure checks'), which it must match cell by cell."""
     reason = lab_harness.missing_reason()
     if reason:
         pytest.skip(reason)

@@ -200,14 +200,11 @@ def test_replay_gives_the_shared_outputs_to_the_same_notebook_only():
 
 
 def test_replaying_executes_like_execute_all_but_replays_the_shared_chapters():
-    """The slides' build takes it as its `execute`: a chapter executed already gets its outputs, as
-    execute_all leaves a notebook (no prelude cell kept), and nothing is executed for it."""
+    """The slides' build takes it as its `execute`: each chapter gets the outputs of its shared
+    copy, as execute_all leaves a notebook (no prelude cell kept), and nothing is executed here."""
     shared = _ran("describe()\nreport()", "x = 1", "plot(x)")
 
     class Shared:
-        def has_instructor(self, name):
-            return name == "01_a.ipynb"
-
         def instructor(self, name):
             assert name == "01_a.ipynb"
             return shared
