@@ -86,7 +86,9 @@ def planner_explorer() -> Explorer:
         # full draw, and a step of T is a full draw: the time axis is [0, 2 T])
         fig.legend(handles=[yd, y, ud], loc="outside lower center", ncols=3, fontsize="small")
         marks = [ax.axvline(0, color="0.5", linestyle=":") for ax in (ax_y, ax_u)]
-        ax_y.set_title("planned and simulated position (dotted: the horizon T)")
+        # y=1: atop the axes, where matplotlib puts it with no tick labels or offset text above,
+        # not searched for again at each full draw (7 % of one; a step of T is one)
+        ax_y.set_title("planned and simulated position (dotted: the horizon T)", y=1.0)
         for line in (yd, y, ud):
             line.sticky_edges.x.append(0.0)    # time starts at 0: no room before it
         return dict(ax_y=ax_y, ax_u=ax_u, yd=yd, y=y, ud=ud, marks=marks)
@@ -236,7 +238,7 @@ def robot_planner_explorer() -> Explorer:
         ax.set_xlabel("x1 [m]")
         ax.set_ylabel("x2 [m]")
         ax.set_box_aspect(PATH_BOX)         # its limits keep x1 and x2 on one scale (_same_scale)
-        ax.set_title("path in the plane")
+        ax.set_title("path in the plane", y=1.0)          # y=1: as the planner's title
         ax.grid(True, alpha=0.4)
         u1, = ax_u.plot([], [], label="speed u1 [m/s]", **curve_style(0))
         u2, = ax_u.plot([], [], label="turn rate u2 [rad/s]", **curve_style(1))
@@ -244,7 +246,7 @@ def robot_planner_explorer() -> Explorer:
             line.sticky_edges.x.append(0.0)    # time starts at 0: no room before it
         ax_u.set_xlabel("time t [s]")
         ax_u.set_ylabel("u1 [m/s], u2 [rad/s]")
-        ax_u.set_title("inputs psi_u (2.102)")
+        ax_u.set_title("inputs psi_u (2.102)", y=1.0)
         # one legend below the axes: out of the data, drawn with the background, not at every
         # frame (a "best" place inside the axes was searched anew at each frame: half its time)
         fig.legend(handles=[path, driven, goal, u1, u2], loc="outside lower center", ncols=3,
