@@ -238,7 +238,7 @@ def robot_planner_explorer() -> Explorer:
         ax.set_xlabel("x1 [m]")
         ax.set_ylabel("x2 [m]")
         ax.set_box_aspect(PATH_BOX)         # its limits keep x1 and x2 on one scale (_same_scale)
-        ax.set_title("path in the plane", y=1.0)          # y=1: as the planner's title
+        ax.set_title("path in the plane")
         ax.grid(True, alpha=0.4)
         u1, = ax_u.plot([], [], label="speed u1 [m/s]", **curve_style(0))
         u2, = ax_u.plot([], [], label="turn rate u2 [rad/s]", **curve_style(1))
@@ -246,7 +246,7 @@ def robot_planner_explorer() -> Explorer:
             line.sticky_edges.x.append(0.0)    # time starts at 0: no room before it
         ax_u.set_xlabel("time t [s]")
         ax_u.set_ylabel("u1 [m/s], u2 [rad/s]")
-        ax_u.set_title("inputs psi_u (2.102)", y=1.0)
+        ax_u.set_title("inputs psi_u (2.102)")
         # one legend below the axes: out of the data, drawn with the background, not at every
         # frame (a "best" place inside the axes was searched anew at each frame: half its time)
         fig.legend(handles=[path, driven, goal, u1, u2], loc="outside lower center", ncols=3,
