@@ -118,3 +118,21 @@ def test_a_step_of_the_pendulum_s_initial_angle_keeps_the_limits_within_an_eight
     e.controls["theta0_deg"].value = -50.0                     # the other side, past an eighth turn
     low, high = ax_th.get_ylim()
     assert -100 < low < -90 and 0 < high < 10
+
+
+def test_a_drag_of_the_pendulum_s_initial_angle_only_grows_the_angle_axis_until_it_rests():
+    """Issue 34: the angle axis followed each eighth turn both ways while a hand dragged, so a
+    drag out and back drew the whole figure about every other frame; it only grows while the hand
+    moves (the policy of `rescale`), and at rest it is that of the settings alone."""
+    from coursekit.explorers import limits
+    e, fresh = ch3.upright_pendulum_explorer(), ch3.upright_pendulum_explorer()
+    ax_th, draws, shown = e.handles["ax_th"], e.frames.full_draws, []
+    for value in [*range(25, -155, -5), *range(-150, 35, 5)]:
+        with limits.moving():
+            e.controls["theta0_deg"].value = float(value)
+        shown.append(ax_th.get_ylim())
+    assert all(a[0] >= b[0] and a[1] <= b[1] for a, b in zip(shown, shown[1:])), "the angle axis shrank"
+    assert e.frames.full_draws - draws <= 8
+    e.refresh()                                   # at rest
+    fresh.controls["theta0_deg"].value = 30.0
+    assert ax_th.get_ylim() == fresh.handles["ax_th"].get_ylim()

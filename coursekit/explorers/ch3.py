@@ -20,7 +20,7 @@ from ..systems import StateSpace
 from ..stability import format_poles
 from ..style import PALETTE, course_subplots, curve_style
 from ._base import Explorer, slider
-from .limits import Y_EDGE, rescale
+from .limits import Y_EDGE, is_moving, rescale
 
 __all__ = ["pair_poles", "pole_placement_compute", "pole_placement_explorer", "upright_pendulum_compute",
            "upright_pendulum_explorer", "integral_action_compute", "integral_action_explorer"]
@@ -230,7 +230,10 @@ def upright_pendulum_explorer() -> Explorer:
             ax.set_xlim(0, r["t"][-1])
         # limits a step of the initial angle keeps (a blitted frame, not a full draw): the angles
         # out to whole eighth turns, and the torque limit (the torques are clipped to it)
-        h["ax_th"].set_ylim(*_eighth_turns(np.r_[r["dev_linear"], r["dev_fl"]]))
+        low, high = _eighth_turns(np.r_[r["dev_linear"], r["dev_fl"]])
+        if is_moving():     # a hand drags: the angle axis only grows (each eighth turn was a full draw)
+            low, high = min(low, h["ax_th"].get_ylim()[0]), max(high, h["ax_th"].get_ylim()[1])
+        h["ax_th"].set_ylim(low, high)
         h["ax_u"].relim()
         h["ax_u"].update_datalim([[0.0, -r["u_max"]], [0.0, r["u_max"]]])
         rescale(h["ax_u"], relim=False, fill=0.9)
