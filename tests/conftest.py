@@ -3,9 +3,17 @@
 
 import os
 
-import numpy as np
-import pytest
-from hypothesis import HealthCheck, settings
+# One BLAS thread per process (unless the environment says otherwise): the run spreads over the
+# cores by processes (xdist's workers, the kernels they start, Chromium), and OpenBLAS's own
+# threads on top of them, for the course's small matrices, only wait on each other for a core
+# (about 15 % of the CPU of a sweep of explorers on 2 cores). Set before numpy loads OpenBLAS
+# here, and inherited by every worker and kernel started from here.
+for _threads in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_threads, "1")
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from hypothesis import HealthCheck, settings  # noqa: E402
 
 # pytester: tests/test_suite_plugin.py runs small test sessions of its own
 pytest_plugins = ["pytester", "suite_plugin"]
