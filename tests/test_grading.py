@@ -11,8 +11,9 @@ of a folder of chapter-1 submissions:
 * ``loop``, ``exit``, ``memory``, ``invalid``, ``chapter2``, ``untitled3``, ``files``: an
   endless loop (one that sleeps: the grader's limit is a time, and a spinning loop would only
   take a core from the rest of the test run for the limit's 45 s, twice), ``os._exit(3)``, a
-  50 GiB allocation, invalid JSON, another chapter's notebook and cells that write and delete files around them: each
-  gets its status, and the answers given before (and after) the accident count.
+  50 GiB allocation, invalid JSON, another chapter's notebook and cells that write and delete
+  files around them: each gets its status, and the answers given before (and after) the
+  accident count.
 
 The other notebooks hold the exercise section only (not the whole chapter),
 which keeps the run short; the chapter's other cells run in their own tests.
@@ -56,8 +57,8 @@ def _submissions(folder: Path) -> None:
         "student": edition.cells,                       # the whole edition, untouched
         "patched": [heading, *setup, patch, *student[2:]],
         "tampered": [heading, *setup, tamper],
-        "loop": [heading, *setup, *answer(right, CHECKS[0]), new_code_cell("import time\nwhile True:\n    time.sleep(0.05)"),
-                 *answer(right, CHECKS[1])],
+        "loop": [heading, *setup, *answer(right, CHECKS[0]),
+                 new_code_cell("import time\nwhile True:\n    time.sleep(0.05)"), *answer(right, CHECKS[1])],
         "exit": [heading, *setup, *answer(right, CHECKS[1]), new_code_cell("import os\nos._exit(3)")],
         "memory": [heading, *setup, *answer(right, CHECKS[3]),
                    new_code_cell("big = np.ones(50 * 2**30, dtype=np.uint8)"),
