@@ -23,7 +23,10 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import subprocess
+import sys
 import time
+from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import nbformat
@@ -79,15 +82,22 @@ def _submissions(folder: Path) -> None:
 
 @pytest.fixture(scope="module")
 def graded(tmp_path_factory):
-    """The submissions folder and the output of grading it twice (the second run is compared);
-    in the sandbox where bubblewrap runs, else without (these notebooks harm nobody)."""
+    """The submissions folder and the output of grading it twice (the second run is compared),
+    by `grade` and, at the same time, by the command an instructor types (each run spends most
+    of its time waiting on the endless loop's limit); in the sandbox where bubblewrap runs, else
+    without (these notebooks harm nobody)."""
     folder = tmp_path_factory.mktemp("submissions")
     _submissions(folder)
     out, again = tmp_path_factory.mktemp("grades"), tmp_path_factory.mktemp("again")
-    grade(folder, out, chapter=1, timeout=TIMEOUT, memory="2G", jobs=2, sandbox=SANDBOX)
-    status = main(["grade", "--chapter", "1", str(folder), "--out", str(again), "--timeout", str(TIMEOUT),
-                   "--memory", "2G", "--jobs", "2", *([] if SANDBOX else ["--no-sandbox"])])
-    assert status == 0
+    command = subprocess.Popen(
+        [sys.executable, "-m", "coursekit", "grade", "--chapter", "1", str(folder), "--out", str(again),
+         "--timeout", str(TIMEOUT), "--memory", "2G", "--jobs", "2", *([] if SANDBOX else ["--no-sandbox"])],
+        stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        grade(folder, out, chapter=1, timeout=TIMEOUT, memory="2G", jobs=2, sandbox=SANDBOX)
+    finally:
+        printed = command.communicate()[0]
+    assert command.returncode == 0, printed
     return folder, out, again
 
 
@@ -246,8 +256,7 @@ def test_only_the_runners_own_outcomes_are_accepted(printed):
 
 def test_feedback_is_caught_per_thread():
     """Two students' answers checked at once keep their own feedback (no process-wide redirect)."""
-    from concurrent.futures import ThreadPoolExecutor
-
+    
     from coursekit.tools.grading import grade_answers
     exercises = chapter_exercises(1)[:1]
     answers = {"right": {"A": [[0, 1], [-4, -0.2]], "B": [[0], [0.5]], "C": [[1, 0]]},
