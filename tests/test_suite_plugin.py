@@ -4,6 +4,7 @@ replay of the session's executed chapters into the slides' build (tests/executed
 
 from __future__ import annotations
 
+import os
 import re
 from pathlib import Path
 
@@ -76,6 +77,18 @@ def test_spread_over_workers_the_skip_line_is_still_written_once(pytester):
     result = pytester.runpytest("-n", "2", "--dist", "loadgroup")
     result.assert_outcomes(skipped=4)
     assert len([line for line in result.outlines if line.startswith("4 browser tests skipped: Chromium")]) == 1
+
+
+def test_logical_starts_one_worker_more_than_the_cores_unless_the_environment_says(pytester, monkeypatch):
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
+    _conftest_for_workers(pytester)
+    pytester.makepyfile(test_ck_one="def test_one():\n    pass\n")
+    monkeypatch.delenv("PYTEST_XDIST_AUTO_NUM_WORKERS", raising=False)
+    result = pytester.runpytest("-n", "logical")
+    result.assert_outcomes(passed=1)
+    assert f"created: {cores + 1}/{cores + 1} workers" in result.stdout.str()
+    monkeypatch.setenv("PYTEST_XDIST_AUTO_NUM_WORKERS", "1")
+    assert suite_plugin.pytest_xdist_auto_num_workers(None) is None     # xdist's own hook reads it
 
 
 _SESSION_CONFTEST = """
