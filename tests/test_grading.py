@@ -26,7 +26,6 @@ import csv
 import subprocess
 import sys
 import time
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import nbformat
@@ -256,7 +255,8 @@ def test_only_the_runners_own_outcomes_are_accepted(printed):
 
 def test_feedback_is_caught_per_thread():
     """Two students' answers checked at once keep their own feedback (no process-wide redirect)."""
-    
+    from concurrent.futures import ThreadPoolExecutor
+
     from coursekit.tools.grading import grade_answers
     exercises = chapter_exercises(1)[:1]
     answers = {"right": {"A": [[0, 1], [-4, -0.2]], "B": [[0], [0.5]], "C": [[1, 0]]},
