@@ -4,7 +4,6 @@ replay of the session's executed chapters into the slides' build (tests/executed
 
 from __future__ import annotations
 
-import os
 import re
 from pathlib import Path
 
@@ -79,16 +78,20 @@ def test_spread_over_workers_the_skip_line_is_still_written_once(pytester):
     assert len([line for line in result.outlines if line.startswith("4 browser tests skipped: Chromium")]) == 1
 
 
+def _workers(result) -> int:
+    return int(re.search(r"created: (\d+)/\1 worker", result.stdout.str())[1])
+
+
 def test_logical_starts_one_worker_more_than_the_cores_unless_the_environment_says(pytester, monkeypatch):
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count()
-    _conftest_for_workers(pytester)
     pytester.makepyfile(test_ck_one="def test_one():\n    pass\n")
     monkeypatch.delenv("PYTEST_XDIST_AUTO_NUM_WORKERS", raising=False)
+    cores = _workers(pytester.runpytest("-n", "logical"))          # pytest-xdist's own count
+    _conftest_for_workers(pytester)
     result = pytester.runpytest("-n", "logical")
     result.assert_outcomes(passed=1)
-    assert f"created: {cores + 1}/{cores + 1} workers" in result.stdout.str()
+    assert _workers(result) == cores + 1
     monkeypatch.setenv("PYTEST_XDIST_AUTO_NUM_WORKERS", "1")
-    assert suite_plugin.pytest_xdist_auto_num_workers(None) is None     # xdist's own hook reads it
+    assert _workers(pytester.runpytest("-n", "logical")) == 1
 
 
 _SESSION_CONFTEST = """
