@@ -35,7 +35,7 @@ __all__ = ["CHROMIUM_ARGS", "TOKEN", "VIEWPORT", "HarnessError", "chromium_path"
            "write_notebook", "running_lab", "launched_chromium", "new_lab_page", "open_notebook",
            "run_all", "wait_until_done", "close_all", "shut_down_kernels", "install_probe",
            "probe_state", "execute_in_kernel", "EXPLORER", "first_slider", "drag", "wait_until_quiet",
-           "error_outputs", "stderr_lines", "axe_source", "axe_violations"]
+           "error_outputs", "stderr_lines", "teardown_page_error", "axe_source", "axe_violations"]
 
 CHROMIUM_ARGS = ["--headless", "--no-sandbox", "--disable-gpu", "--disable-background-networking",
                  "--disable-component-update", "--disable-sync", "--no-first-run"]
@@ -172,12 +172,33 @@ def launched_chromium():
             browser.close()
 
 
+# JupyterLab (4.4 and later) gives the comms of each comm target a kernel subshell of their own:
+# opening a comm sends a create_subshell_request, and one of the promises that wait for its reply
+# has no error handler. When the kernel connection goes away before the reply (a test closes the
+# notebook or stops its kernel just as the widget manager opens its control comm), JupyterLab
+# cancels the request and the page reports the rejection as an uncaught error. It comes from the
+# test's teardown, never from the course; `test_browser_notebook_view.py` provokes it.
+_TEARDOWN_PAGE_ERROR = re.compile(
+    r"(Error: )?Canceled future for create_subshell_request message before replies were done")
+
+
+def teardown_page_error(message: str) -> bool:
+    """Whether the uncaught page error `message` is JupyterLab's cancelled subshell request
+    (see `_TEARDOWN_PAGE_ERROR`) rather than an error to report."""
+    return _TEARDOWN_PAGE_ERROR.fullmatch(message.strip()) is not None
+
+
+def _record_page_error(page, message: str) -> None:
+    (page.ck_teardown_errors if teardown_page_error(message) else page.ck_page_errors).append(message)
+
+
 def new_lab_page(browser, url: str, *, viewport: dict = VIEWPORT):
     """A page with JupyterLab loaded and ready to open documents; uncaught page errors are
-    collected in ``page.ck_page_errors``."""
+    collected in ``page.ck_page_errors``, except JupyterLab's cancelled subshell requests
+    (`teardown_page_error`), which go to ``page.ck_teardown_errors``."""
     page = browser.new_page(viewport=viewport)
-    page.ck_page_errors = []
-    page.on("pageerror", lambda error: page.ck_page_errors.append(str(error)))
+    page.ck_page_errors, page.ck_teardown_errors = [], []
+    page.on("pageerror", lambda error: _record_page_error(page, str(error)))
     page.goto(f"{url}/lab?reset&token={TOKEN}")
     page.wait_for_function("() => window.jupyterapp?.commands?.hasCommand('docmanager:open')",
                            timeout=90_000)

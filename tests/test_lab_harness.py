@@ -1,7 +1,9 @@
 """The browser harness's reading of the kernel's stderr (`lab_harness.stderr_lines`), without a
 browser: the kernel cuts its stream into messages wherever it flushes, and the widget manager's
-refused control comm must be left out however its lines arrive. In Chromium: axe-core, left to
-check one token of highlighted code per look and ground, still finds every faint one."""
+refused control comm must be left out however its lines arrive. Of the page's uncaught errors,
+only JupyterLab's cancelled subshell request is set aside (`lab_harness.teardown_page_error`).
+In Chromium: axe-core, left to check one token of highlighted code per look and ground, still
+finds every faint one."""
 
 from __future__ import annotations
 
@@ -32,6 +34,16 @@ def test_other_lines_around_the_refusal_are_kept():
     assert lab_h.stderr_lines(chunks, {"abc123"}) == [
         "Traceback (most recent call last):", "No such comm: other"]
     assert lab_h.stderr_lines(["No such comm: abc123\n"], set()) == ["No such comm: abc123"]
+
+
+def test_only_jupyterlabs_cancelled_subshell_request_counts_as_teardown():
+    cancelled = "Canceled future for create_subshell_request message before replies were done"
+    assert lab_h.teardown_page_error(cancelled)
+    assert lab_h.teardown_page_error(f"Error: {cancelled}\n")
+    for other in ("Error: Canceled future for execute_request message before replies were done",
+                  f"TypeError: {cancelled}", f"{cancelled}; then the widget failed",
+                  "Error: widget model not found", ""):
+        assert not lab_h.teardown_page_error(other), other
 
 
 # axe-core on highlighted code (a browser is needed) ------------------------------------------
