@@ -22,7 +22,8 @@ to it: every state a reader can reach shows the figure computed for exactly thos
 The frame of settings S is what the explorer draws after one move from its defaults to S, at
 rest, as in JupyterLab: the view limits it had for its defaults, then its update for S (and,
 when ``compute`` fails for S, the figure of the defaults with the readout saying why), laid out
-for S (`render_settled`), so that no frame depends on the frames drawn before it.
+for S from where the defaults' layout put the axes (`render_settled`), so that no frame depends
+on the frames drawn before it.
 The frames are lossless (WebP through Pillow), at most `FRAME_BUDGET` bytes per explorer
 (fewer values per slider when they would be more) and `SITE_BUDGET` for a whole build.
 """
@@ -184,7 +185,7 @@ def _webp(rgba) -> bytes:
 
 
 def _smallest_text_pt(fig) -> float | None:
-    """Of a frame just rendered with its layout settled (`render_settled`): no second draw."""
+    """Of a frame just rendered and laid out (`render_settled`): no second draw."""
     from .site_figures import smallest_text_pt
     return smallest_text_pt(fig, drawn=True)
 
@@ -200,17 +201,15 @@ def _move(explorer, settings: dict, defaults: dict, view) -> None:
         explorer.apply(defaults)
 
 
-def render_settled(explorer, passes: int = 4) -> None:
-    """Render the explorer's figure with its layout settled: laid out again until its axes stay
-    where they are (constrained layout counts the ticks of axes placed by the previous layout, so
-    one pass depends on where they stood; a blit keeps the background's layout, that of the same
-    limits and text). The frame then does not depend on the frames drawn before it."""
-    for _ in range(passes):
-        places = [ax.get_position().bounds for ax in explorer.fig.axes]
-        explorer.frames.relayout()
-        explorer.frames.render()
-        if [ax.get_position().bounds for ax in explorer.fig.axes] == places:
-            return
+def render_settled(explorer) -> None:
+    """Render the explorer's figure laid out for what it shows now, in one layout pass from where
+    its axes stand: for a frame, where the defaults' layout put them (`_move` puts them back), so
+    that the frame does not depend on the frames drawn before it (constrained layout counts the
+    ticks of the axes as they stand, so its result depends on where they stood). A second pass
+    would move the axes of most frames by less than 2 pixels; JupyterLab, which lays a figure
+    out again only when its text measures otherwise, does not make it either."""
+    explorer.frames.relayout()
+    explorer.frames.render()
 
 
 def _one_frame(explorer, settings: dict, defaults: dict, view, dpi: float) -> dict:
