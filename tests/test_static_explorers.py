@@ -128,7 +128,7 @@ def _one_move(factory, settings: dict, *, column: bool) -> tuple[np.ndarray, str
             ax.set_position(place)
             ax.set_in_layout(True)
         fresh.frames.reset()                 # a full draw: not blitted over the defaults' layout
-        se.render_settled(fresh)
+        se.render_laid_out(fresh)
         return np.asarray(fresh.frames.canvas.buffer_rgba())[..., :3].astype(int), fresh.alt
 
 

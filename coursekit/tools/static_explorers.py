@@ -22,7 +22,7 @@ to it: every state a reader can reach shows the figure computed for exactly thos
 The frame of settings S is what the explorer draws after one move from its defaults to S, at
 rest, as in JupyterLab: the view limits it had for its defaults, then its update for S (and,
 when ``compute`` fails for S, the figure of the defaults with the readout saying why), laid out
-for S from where the defaults' layout put the axes (`render_settled`), so that no frame depends
+for S from where the defaults' layout put the axes (`render_laid_out`), so that no frame depends
 on the frames drawn before it.
 The frames are lossless (WebP through Pillow), at most `FRAME_BUDGET` bytes per explorer
 (fewer values per slider when they would be more) and `SITE_BUDGET` for a whole build.
@@ -44,7 +44,7 @@ from pathlib import Path
 import numpy as np
 
 __all__ = ["MIME", "MAX_FRAMES", "FULL_GRID_MIN", "FRAME_BUDGET", "SITE_BUDGET", "ASSETS", "ASSET_FILES",
-           "slider_values", "plan", "render_settled", "render_frames", "explorer_data", "install",
+           "slider_values", "plan", "render_laid_out", "render_frames", "explorer_data", "install",
            "explorer_html", "publish", "copy_assets", "check_site_budget"]
 
 #: the media type under which the kernel adds an explorer's frames to its display data
@@ -185,7 +185,7 @@ def _webp(rgba) -> bytes:
 
 
 def _smallest_text_pt(fig) -> float | None:
-    """Of a frame just rendered and laid out (`render_settled`): no second draw."""
+    """Of a frame just rendered and laid out (`render_laid_out`): no second draw."""
     from .site_figures import smallest_text_pt
     return smallest_text_pt(fig, drawn=True)
 
@@ -201,7 +201,7 @@ def _move(explorer, settings: dict, defaults: dict, view) -> None:
         explorer.apply(defaults)
 
 
-def render_settled(explorer) -> None:
+def render_laid_out(explorer) -> None:
     """Render the explorer's figure laid out for what it shows now, in one layout pass from where
     its axes stand: for a frame, where the defaults' layout put them (`_move` puts them back), so
     that the frame does not depend on the frames drawn before it (constrained layout counts the
@@ -215,7 +215,7 @@ def render_settled(explorer) -> None:
 def _one_frame(explorer, settings: dict, defaults: dict, view, dpi: float) -> dict:
     """The frame of `settings`: one move from the defaults, at rest."""
     _move(explorer, settings, defaults, view)
-    render_settled(explorer)
+    render_laid_out(explorer)
     text = explorer.text
     width, height = explorer.frames.canvas.get_width_height(physical=True)
     return dict(image=_webp(explorer.frames.canvas.buffer_rgba()), alt=explorer.alt_for(text, settings),
