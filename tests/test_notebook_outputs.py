@@ -20,11 +20,7 @@ NOTEBOOKS = chapter_notebooks(Path(__file__).resolve().parents[1] / "notebooks")
 NUMPY_REPR = re.compile(r"\bnp\.(?:float|int|uint|complex|bool|str_|True_|False_)\w*\b")
 
 
-# last chapter first: this module and tests/test_figure_style.py are handed out at the start of a
-# run (tests/suite_plugin.py), and that one asks for the chapters first to last; each worker then
-# executes the chapters no worker has started yet, instead of this one waiting on each in turn
-# (the shared chapters were ready after 122 s in one worker; a worker of the run stood idle)
-@pytest.mark.parametrize("path", NOTEBOOKS[::-1], ids=[p.stem for p in NOTEBOOKS[::-1]])
+@pytest.mark.parametrize("path", NOTEBOOKS, ids=[p.stem for p in NOTEBOOKS])
 def test_no_output_shows_a_numpy_scalar_repr(path, executed_chapters):
     executed = executed_chapters.instructor(path.name)
     found = [f"cell {index}: {line.strip()}" for index, text in text_outputs(executed)
