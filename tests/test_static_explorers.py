@@ -19,9 +19,10 @@ from coursekit.tools import static_explorers as se
 from coursekit.tools.site_figures import drawn_for_the_column
 
 
-def _lag(fail_above: float | None = None, sliders: int = 1, **kinds) -> Explorer:
+def _lag(fail_above: float | None = None, sliders: int = 1, note: bool = False, **kinds) -> Explorer:
     """A small explorer (docs/extending.md's first-order lag) with up to three sliders and the
-    dropdowns `kinds` (name -> options); compute raises for a rate above `fail_above`."""
+    dropdowns `kinds` (name -> options); compute raises for a rate above `fail_above`; with `note`,
+    a text right of the axes, as long as the time constant's digits, says how fast the lag is."""
     def compute(a=1.0, gain=1.0, delay=0.0, **choices):
         if fail_above is not None and a > fail_above:
             raise ValueError(f"a = {a:g} is too fast for this test")
@@ -32,10 +33,12 @@ def _lag(fail_above: float | None = None, sliders: int = 1, **kinds) -> Explorer
         ax = fig.subplots()
         line, = ax.plot([], [], label="x(t)")
         ax.set(xlabel="time t [s]", ylabel="x", title="step response")
-        return dict(ax=ax, line=line)
+        return dict(ax=ax, line=line, note=ax.text(1.03, 0.5, "", transform=ax.transAxes) if note else None)
 
     def update(h, r):
         h["line"].set_data(r["t"], r["x"])
+        if note:
+            h["note"].set_text(f"tau = {r['tau']:.6g} s")
         h["ax"].set_xlim(0, r["t"][-1])
         rescale(h["ax"])
 
@@ -173,6 +176,20 @@ def test_each_frame_is_the_figure_of_one_move_from_the_defaults(factory, column)
         frame = frames[n]
         assert frame["alt"] == alt and frame["readout"].replace("\n", "; ") in alt
     assert explorer.params == {c["name"]: c["values"][c["default"]] for c in chosen["controls"]}
+
+
+@pytest.mark.parametrize("note", [False, True], ids=["curve-only", "text-beside-the-axes"])
+def test_frames_drawn_together_are_those_drawn_alone_and_blitted_where_the_layout_stays(note):
+    """Rates of the same limits: their frames share a layout, and all but the first are blitted in
+    it, unless a text beside the axes changes with them (constrained layout measures it: each frame
+    is laid out again). Either way each frame is, byte for byte, the frame rendered alone."""
+    rates = [1.5, 2.0, 2.5, 3.0, 4.0, 5.0]
+    explorer = _lag(note=note)
+    together = se.render_frames(explorer, [dict(a=a) for a in rates], column=False)
+    alone = [se.render_frames(_lag(note=note), [dict(a=a)], column=False)[0] for a in rates]
+    assert [f["image"] for f in together] == [f["image"] for f in alone]
+    assert len({f["image"] for f in together}) == len(rates)
+    assert explorer.frames.blits == (0 if note else len(rates) - 1), explorer.frames.blits
 
 
 def test_a_setting_compute_fails_for_shows_the_default_figure_and_says_why():

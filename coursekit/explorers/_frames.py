@@ -61,9 +61,13 @@ class FrameRenderer:
         """Lay the figure out anew at the next full draw, even when its text measures as before."""
         self._layout = None
 
+    def changed(self) -> set:
+        """The artists that can move and changed since they were last drawn (matplotlib's *stale*)."""
+        return {a for a in self._children() if a.stale}
+
     def render(self) -> None:
         """`frame` without the PNG: ``canvas.buffer_rgba()`` then shows the figure as it is now."""
-        changed = {a for a in self._children() if a.stale} if self.full_draws else set()
+        changed = self.changed() if self.full_draws else set()
         new, self.moving = changed - self.moving, self.moving | changed
         if self._background is None or new or self.state() != self._key:
             self._full_draw()
