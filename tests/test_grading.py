@@ -23,6 +23,8 @@ from __future__ import annotations
 
 import contextlib
 import csv
+import importlib.util
+import json
 import subprocess
 import sys
 import time
@@ -251,6 +253,33 @@ def test_only_the_runners_own_outcomes_are_accepted(printed):
     good = _runner_outcome('{"status": "cell error", "detail": "d", "errors": [{"cell": 2, "ename": "E", '
                            '"evalue": "m"}, {"cell": "x"}]}', 0)
     assert good == {"status": "cell error", "detail": "d", "errors": [{"cell": 2, "ename": "E", "evalue": "m"}]}
+
+
+def test_the_runner_refuses_only_the_iri_grammar_and_still_validates_notebooks():
+    """jsonschema's ``iri`` format (rfc3987-syntax's grammar, 1 s of a core on import) stays out
+    of the runner's process; nbformat and nbclient work as before."""
+    if importlib.util.find_spec("rfc3987_syntax") is None:
+        pytest.skip("rfc3987-syntax is not installed here: there is no grammar to leave out")
+    code = ("import sys\nfrom coursekit.tools.grading.runner import leave_out_the_iri_grammar\n"
+            "leave_out_the_iri_grammar()\nimport jsonschema, nbclient, nbformat\n"
+            "nbformat.validate(nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell('1 + 1')]))\n"
+            "print(sys.modules['rfc3987_syntax'], 'iri' in jsonschema.FormatChecker.checkers,\n"
+            "      'email' in jsonschema.FormatChecker.checkers)")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["None", "False", "True"], out
+
+
+def test_the_runner_leaves_out_the_iri_grammar_before_it_runs_the_notebook(monkeypatch, tmp_path):
+    from coursekit.tools.grading import runner
+    calls = []
+    monkeypatch.setattr(runner, "leave_out_the_iri_grammar", lambda: calls.append("left out"))
+    monkeypatch.setattr(runner, "set_limits", lambda *limits: None)      # not on the test's own process
+    monkeypatch.setattr(runner, "execute", lambda job, kernels: calls.append("executed") or
+                        {"status": "ok", "detail": "", "errors": []})
+    job = tmp_path / "job.json"
+    job.write_text(json.dumps({"memory": 2**30}), encoding="utf-8")
+    assert runner.main([str(job)]) == 0
+    assert calls == ["left out", "executed"]
 
 
 def test_feedback_is_caught_per_thread():
