@@ -61,6 +61,12 @@ def test_without_chromium_the_browser_tests_skip_with_one_line(pytester, monkeyp
     assert [line for line in one.outlines if "browser tests skipped" in line][0].startswith("1 browser tests")
 
 
+#: for the runs below that start xdist workers: only the plugins they test. nbval (which imports
+#: jupyter_client and nbformat) and hypothesis cost each process about 3 s of a core to load, and
+#: these runs start eleven workers
+_LEAN = ("-p", "no:nbval", "-p", "no:hypothesispytest")
+
+
 def _conftest_for_workers(pytester, source: str = "") -> None:
     """A conftest that loads suite_plugin from the suite's folder, which pytest-xdist's workers do
     not have on their path (they start from the path this process started with), then `source`."""
@@ -73,7 +79,7 @@ def test_spread_over_workers_the_skip_line_is_still_written_once(pytester):
     _conftest_for_workers(pytester, "import lab_harness\nlab_harness.chromium_path = lambda: None\n")
     pytester.makeini("[pytest]\nmarkers =\n    browser: b\n    notebooks: n\n")
     pytester.makepyfile(test_ck_lab=_BROWSER_TESTS.format(name="lab"), test_ck_site=_BROWSER_TESTS.format(name="site"))
-    result = pytester.runpytest("-n", "2", "--dist", "loadgroup")
+    result = pytester.runpytest(*_LEAN, "-n", "2", "--dist", "loadgroup")
     result.assert_outcomes(skipped=4)
     assert len([line for line in result.outlines if line.startswith("4 browser tests skipped: Chromium")]) == 1
 
@@ -85,13 +91,13 @@ def _workers(result) -> int:
 def test_logical_starts_one_worker_more_than_the_cores_unless_the_environment_says(pytester, monkeypatch):
     pytester.makepyfile(test_ck_one="def test_one():\n    pass\n")
     monkeypatch.delenv("PYTEST_XDIST_AUTO_NUM_WORKERS", raising=False)
-    cores = _workers(pytester.runpytest("-n", "logical"))          # pytest-xdist's own count
+    cores = _workers(pytester.runpytest(*_LEAN, "-n", "logical"))          # pytest-xdist's own count
     _conftest_for_workers(pytester)
-    result = pytester.runpytest("-n", "logical")
+    result = pytester.runpytest(*_LEAN, "-n", "logical")
     result.assert_outcomes(passed=1)
     assert _workers(result) == cores + 1
     monkeypatch.setenv("PYTEST_XDIST_AUTO_NUM_WORKERS", "1")
-    assert _workers(pytester.runpytest("-n", "logical")) == 1
+    assert _workers(pytester.runpytest(*_LEAN, "-n", "logical")) == 1
 
 
 _SESSION_CONFTEST = """
@@ -132,7 +138,7 @@ def test_work_for_the_run_is_made_once_and_each_module_stays_on_one_worker(pytes
                for name, reads in [("a", "tmp_path"), ("b", "executed_chapters"), ("c", "tmp_path"),
                                    ("d", "executed_chapters")]}
     pytester.makepyfile(**modules)
-    result = pytester.runpytest("-n", "2", "--dist", "loadfile", "--no-loadscope-reorder")
+    result = pytester.runpytest(*_LEAN, "-n", "2", "--dist", "loadfile", "--no-loadscope-reorder")
     result.assert_outcomes(passed=24)
     assert len((tmp_path / "made").read_text().split()) == 1, "made by both workers"
     ran = [line.split() for line in (tmp_path / "ran").read_text().splitlines()]
