@@ -19,7 +19,7 @@ import numpy as np
 
 from .diagnostics import AccuracyWarning, UserFunctionError
 
-__all__ = ["as_matrix", "as_square", "as_vector", "as_series", "as_scalar", "as_time_grid", "is_uniform",
+__all__ = ["MAX_SPAN", "as_matrix", "as_square", "as_vector", "as_series", "as_scalar", "as_time_grid", "is_uniform",
            "as_poles", "as_covariance", "as_integer", "as_dt", "as_text", "as_flag", "require_columns",
            "time_grid", "check_function_output", "call_user", "call_user_fast", "checked_call", "float_array",
            "is_complex", "is_text", "foreign_library", "type_name", "BRIDGES", "function_name",

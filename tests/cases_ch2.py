@@ -7,6 +7,8 @@ from bad_input_cases import T11, bad, ok, scalar_cases
 from coursekit.explorers import ch2 as xp2
 
 scalar_cases("explorers.planner_compute", "T", lambda T: xp2.planner_compute(T=T), 3.0, positive=True)
+scalar_cases("explorers.time_shown", "T", xp2.time_shown, 3.0, positive=True)
+bad("explorers.time_shown", "T 1e308", lambda: xp2.time_shown(1e308), "T")
 bad("explorers.planner_compute", "r 1", lambda: xp2.planner_compute(r=1), "r")
 bad("explorers.planner_compute", "mass_error -100", lambda: xp2.planner_compute(mass_error=-100.0), "mass_error")
 bad("explorers.planner_compute", "samples 1", lambda: xp2.planner_compute(samples=1), "samples")

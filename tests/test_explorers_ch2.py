@@ -25,6 +25,43 @@ def test_planner_quintic_has_a_continuous_input_and_mass_error_drifts():
     assert wrong["end_error"] > 1e-3
 
 
+@pytest.mark.parametrize("T, r", [(3.1, 2), (0.7, 2), (5.5, 3)])
+def test_planner_matches_an_ode_solver_before_and_after_the_jump_of_u_at_T(T, r):
+    """The plant with a 10 % mass error, driven by u_d (2.30) up to T and by k * target after:
+    against solve_ivp run in two parts on the exact input. The cubic's u_d jumps at T (r = 2),
+    which one simulation over the whole grid would smear over the interval around T."""
+    m0, d, k = ch2.PLANNER_PLANT["m"], ch2.PLANNER_PLANT["d"], ch2.PLANNER_PLANT["k"]
+    m, target = 1.1 * m0, 1.5
+    got = ch2.planner_compute(T=T, target=target, mass_error=10.0, r=r)
+    zeros = [0.0] * (r - 1)
+    traj = ck.poly_trajectory(T, [0.0] + zeros, [target] + zeros)
+    ud = ck.feedforward([k / m0, d / m0], 1.0 / m0, traj)     # planned for the nominal mass
+
+    def plant(u):
+        return lambda t, x: [x[1], (u(t) - d * x[1] - k * x[0]) / m]
+
+    t = got["t"]
+    plan = solve_ivp(plant(lambda s: float(ud(s))), (0.0, T), [0.0, 0.0], rtol=1e-11, atol=1e-13,
+                     dense_output=True)
+    held = solve_ivp(plant(lambda s: k * target), (T, t[-1]), plan.y[:, -1], rtol=1e-11, atol=1e-13,
+                     dense_output=True)
+    expected = np.where(t <= T, plan.sol(np.minimum(t, T))[0], held.sol(np.maximum(t, T))[0])
+    assert t[-1] == pytest.approx(ch2.time_shown(T)) and T in t
+    np.testing.assert_allclose(got["y"], expected, atol=2e-5)
+    assert got["end_error"] == pytest.approx(abs(plan.y[0, -1] - target), abs=2e-5)
+    assert got["end_error"] > 1e-3                           # the mass error shows
+
+
+def test_time_shown_is_two_to_three_horizons_and_changes_at_ten_of_the_slider_s_values():
+    Ts = np.round(np.arange(0.5, 10.05, 0.1), 1)
+    ends = np.array([ch2.time_shown(T) for T in Ts])
+    assert np.all((2 * Ts <= ends + 1e-12) & (ends <= 3 * Ts))
+    assert sorted(set(ends)) == [1.0, 1.5, 2.0, 3.0, 4.0, 6.0, 8.0, 10.0, 15.0, 20.0]
+    assert ch2.time_shown(3.0) == 6.0 and ch2.time_shown(3.1) == 8.0
+    with pytest.raises(ValueError, match="T must be positive"):
+        ch2.time_shown(0.0)
+
+
 def test_robot_planner_drives_the_plan_and_reports_singular_plans():
     r = ch2.robot_planner_compute(x_T=3.0, y_T=2.0, heading_deg=45.0, T=5.0, speed=1.0)
     assert r["end_error"] < 1e-3

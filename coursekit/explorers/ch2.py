@@ -6,10 +6,12 @@ and a ``*_explorer()`` factory that wires it to sliders.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from .. import models
-from .._validation import as_scalar, as_series, as_time_grid, as_vector, time_grid
+from .._validation import MAX_SPAN, as_scalar, as_series, as_time_grid, as_vector, time_grid
 from ..flatness import plan_robot
 from ..simulation import simulate
 from ..style import PALETTE, course_subplots, curve_style
@@ -17,8 +19,8 @@ from ..trajectory import feedforward, poly_trajectory
 from ._base import Explorer, int_slider, slider
 from .limits import rescale
 
-__all__ = ["planner_compute", "planner_explorer", "robot_planner_compute", "robot_planner_explorer",
-           "drive_robot"]
+__all__ = ["planner_compute", "time_shown", "planner_explorer", "robot_planner_compute",
+           "robot_planner_explorer", "drive_robot"]
 
 #: the plant of the trajectory planner: mass-spring-damper (2.27) [kg, N s/m, N/m]
 PLANNER_PLANT = dict(m=1.0, d=0.5, k=2.0)
@@ -36,10 +38,14 @@ def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0
 
     Plans the polynomial of degree 2r - 1 with y_d(0) = 0, y_d(T) = target and
     derivatives 1..r-1 zero at both ends (r = 2: the cubic (2.40); r = 3 also
-    makes the acceleration, hence u_d, continuous at 0 and T), computes u_d = k y_d + d y_d' + m y_d'' (2.30), i.e. (2.25)
-    with a = [k/m, d/m], b = 1/m, and applies it for 2 T to the plant whose
-    mass is off by `mass_error` percent. Returns ``t, yd, ud, y`` (time-major
-    arrays), ``end_error`` = |y(T) - target| and the parameters.
+    makes the acceleration, hence u_d, continuous at 0 and T), computes
+    u_d = k y_d + d y_d' + m y_d'' (2.30), i.e. (2.25) with a = [k/m, d/m],
+    b = 1/m, and applies it to the plant whose mass is off by `mass_error`
+    percent, then holds u = k target from T to `time_shown` (T) (2 T to 3 T).
+    The two parts are simulated one after the other, so the jump of the
+    cubic's u_d at T is taken exactly. Returns ``t, yd, ud, y`` (time-major
+    arrays over `samples` times, T one of them),
+    ``end_error`` = |y(T) - target| and the parameters.
     """
     T = as_scalar(T, "T", positive=True)
     target = as_scalar(target, "target")
@@ -56,22 +62,36 @@ def planner_compute(T: float = 3.0, target: float = 1.0, mass_error: float = 0.0
     zeros = [0.0] * (r - 1)
     traj = poly_trajectory(T, [0.0] + zeros, [target] + zeros)
     ud = feedforward([k / m, d / m], 1.0 / m, traj)
-    t = time_grid(2.0 * T, samples, t_end_name="T")
-    # after T the plan holds y_d = target, so u_d = k * target
-    u = np.where(t <= T, ud(np.minimum(t, T)), k * target)
+    end = time_grid(time_shown(T), samples, t_end_name="T")[-1]    # checks the span and `samples`
+    before = max(2, round((samples - 1) * T / end) + 1)               # samples on [0, T], the rest after
+    t_plan, t_held = np.linspace(0.0, T, before), np.linspace(T, end, max(2, samples - before + 1))
+    u_plan, after = ud(t_plan), np.ones(t_held.size - 1)
     plant = models.mass_spring_damper(m=m * (1.0 + mass_error / 100.0), d=d, k=k)
-    y = simulate(plant, t, u=u.reshape(-1, 1)).x[:, 0]
-    yd = np.where(t <= T, traj(np.minimum(t, T)), target)
-    i_T = int(np.searchsorted(t, T))
-    return dict(t=t, yd=yd, ud=u, y=y, end_error=float(abs(y[i_T] - target)), T=T, target=target,
-                mass_error=mass_error, r=r)
+    planned = simulate(plant, t_plan, u=u_plan.reshape(-1, 1)).x
+    # after T the plan holds y_d = target, so u_d = k * target: a step of u where r = 2
+    held = simulate(plant, t_held - T, u=np.full((t_held.size, 1), k * target), x0=planned[-1]).x
+    return dict(t=np.concatenate([t_plan, t_held[1:]]), yd=np.concatenate([traj(t_plan), target * after]),
+                ud=np.concatenate([u_plan, k * target * after]), y=np.concatenate([planned[:, 0], held[1:, 0]]),
+                end_error=float(abs(planned[-1, 0] - target)), T=T, target=target, mass_error=mass_error, r=r)
+
+
+def time_shown(T: float) -> float:
+    """How long the trajectory planner shows the move of horizon `T`: 2 T rounded up to a multiple
+    of the largest of 1, 2, 5 times a power of ten not above T, so 2 T to 3 T (T = 3 s: 6 s;
+    3.1 s to 4 s: 8 s). Ten ends cover T from 0.5 s to 10 s, so a step of the T slider keeps
+    the time axis (a redraw of the curves alone) but where 2 T passes one of them."""
+    T = as_scalar(T, "T", positive=True, limit=MAX_SPAN / 3,
+                  limit_why=f"the move is shown for up to 3 T, and a time grid spans at most {MAX_SPAN:g} s")
+    step = 10.0 ** math.floor(math.log10(T))
+    step *= max(d for d in (1.0, 2.0, 5.0) if d * step <= T * (1 + 1e-12))
+    return math.ceil(2.0 * T / step - 1e-9) * step
 
 
 def planner_explorer() -> Explorer:
     """Sliders for the horizon T, the target and a mass error: y_d, u_d and the simulated y."""
     def draw(fig):
         # one time axis for both, kept equal by update: not sharex, whose label placement measures
-        # the other axes' tick labels too, at each full draw (a step of T is one)
+        # the other axes' tick labels too, at each full draw (a step of T across a `time_shown` end)
         ax_y, ax_u = course_subplots(fig, 2, 1)
         ax_y.tick_params(labelbottom=False)
         yd, = ax_y.plot([], [], color=PALETTE["black"], linestyle="--", label="planned y_d")
@@ -83,11 +103,11 @@ def planner_explorer() -> Explorer:
         ax_u.set_xlabel("time t [s]")
         ax_u.grid(True, alpha=0.4)
         # one legend below both axes, where it hides no curve (two beside them took a fifth of a
-        # full draw, and a step of T is a full draw: the time axis is [0, 2 T])
+        # full draw, and a step of T across a `time_shown` end is one: the time axis moves)
         fig.legend(handles=[yd, y, ud], loc="outside lower center", ncols=3, fontsize="small")
         marks = [ax.axvline(0, color="0.5", linestyle=":") for ax in (ax_y, ax_u)]
         # y=1: atop the axes, where matplotlib puts it with no tick labels or offset text above,
-        # not searched for again at each full draw (7 % of one; a step of T is one)
+        # not searched for again at each full draw (7 % of one)
         ax_y.set_title("planned and simulated position (dotted: the horizon T)", y=1.0)
         for line in (yd, y, ud):
             line.sticky_edges.x.append(0.0)    # time starts at 0: no room before it
@@ -100,7 +120,7 @@ def planner_explorer() -> Explorer:
         for line in h["marks"]:
             line.set_xdata([r["T"], r["T"]])
         rescale(h["ax_y"], h["ax_u"])
-        rescale(h["ax_u"], axis="x", fill=1.0)   # the time axis: exactly [0, 2 T] at rest
+        rescale(h["ax_u"], axis="x", fill=1.0)   # the time axis: exactly [0, time_shown(T)] at rest
         h["ax_y"].set_xlim(h["ax_u"].get_xlim())
 
     def readout(r):
