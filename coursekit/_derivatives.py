@@ -150,11 +150,16 @@ def _ridders_column(D: np.ndarray, noise: np.ndarray) -> tuple[np.ndarray, float
 
 
 # A column along which g is affine (a straight line to rounding) is the same quotient at every
-# step, and the largest step rounds least: it is taken from three steps (powers of two of the
-# point's scale, its golden-ratio fraction, and 2^-10 of it) when their quotients agree and the
+# step, and the largest step rounds least: it is taken from four steps (powers of two of the
+# point's scale, its golden-ratio fraction, and 2^-10 of both) when their quotients agree and the
 # second differences vanish to _AFFINE_RTOL of the column's size, plus their rounding.
 _AFFINE_RTOL = 1e-12
-_AFFINE_STEPS = (1.0, _OTHER, 2.0 ** -10)
+_AFFINE_STEPS = (1.0, _OTHER, 2.0 ** -10, _OTHER * 2.0 ** -10)
+# the steps at most this fraction of the largest: a curvature would bend them 2^-20 as much, so
+# their second differences measure the rounding inside g (intermediate values larger than g's),
+# where they are at most _NOISE_MAX of the change over the largest step (not a fast oscillation)
+_NOISE_STEPS = 2.0 ** -10
+_NOISE_MAX = 1e-8
 
 
 # the rounding of a difference: a few eps of the values involved, with room for the rounding
@@ -166,14 +171,19 @@ def _affine_column(g: Callable, z: np.ndarray, k: int, q: int,
                    scale: float) -> tuple[np.ndarray, float] | None:
     """(dg/dz_k, error estimate) when g is affine along e_k at the scale of the point, else None.
 
-    The steps are h = s * (1, 0.618..., 2^-10), s = 2^round(log2 max(scale, |z|)) / 4
-    (`scale`: the size of the whole point, x and u, whose rounding inside g a
-    step much smaller than it would magnify); for each, the central difference
-    D(h) must equal D(s) to _AFFINE_RTOL |D(s)| s / h, and g(z + h e_k) +
-    g(z - h e_k) - 2 g(z) must vanish to 8 _AFFINE_RTOL |D(s)| s, plus the
-    rounding of the values (rounding inside g is the same absolute error at
-    every step, hence the factors s / h and s). Then D(s) is exact to rounding
-    (no truncation error on a straight line), whatever the scale of the
+    The steps are h = s * (1, 0.618..., 2^-10, 0.618... 2^-10), s =
+    2^round(log2 max(scale, |z|)) / 4 (`scale`: the size of the whole point,
+    x and u, whose rounding inside g a step much smaller than it would
+    magnify); for each, the central difference D(h) must equal D(s) to
+    _AFFINE_RTOL |D(s)| s / h, and g(z + h e_k) + g(z - h e_k) - 2 g(z) must
+    vanish to 8 _AFFINE_RTOL |D(s)| s, plus the rounding of the values
+    (rounding inside g is the same absolute error at every step, hence the
+    factors s / h and s) and 8 times the second differences of the two small
+    steps where they are below _NOISE_MAX |D(s)| s (the rounding inside g: a
+    term A x of 10^4 beside a column of 10^-2, which the values of g do not
+    show; a curvature would bend the largest step 2^20 times as much, and a
+    fast oscillation is not that small). Then D(s) is exact to rounding (no
+    truncation error on a straight line), whatever the scale of the
     coefficients; for a smooth f that passes, its error is below ~1e-11.
     """
     top = 2.0 ** np.round(np.log2(max(scale, float(np.abs(z).max())))) / 4
@@ -185,11 +195,15 @@ def _affine_column(g: Callable, z: np.ndarray, k: int, q: int,
     with np.errstate(all="ignore"):
         quotients = [(plus - minus) / width for plus, minus, width in rows]
         size = float(np.abs(quotients[0]).max())
+        noise = np.max([np.abs(plus + minus - 2 * center)
+                        for (plus, minus, _), factor in zip(rows, _AFFINE_STEPS) if factor <= _NOISE_STEPS], axis=0)
+        noise = np.where(noise <= _NOISE_MAX * size * top, 8 * noise, 0.0)
         worst = 0.0
         for (plus, minus, width), D in zip(rows, quotients):
             # rounding inside g (intermediate values larger than g's) is the same at every step, so
             # its share of D grows like 1 / width: the tolerances grow alike, from the top step's
-            rounding = _ROUNDING * (np.abs(plus) + np.abs(minus) + 2 * np.abs(center) + abs(z[k]) * np.abs(D))
+            rounding = noise + _ROUNDING * (np.abs(plus) + np.abs(minus) + 2 * np.abs(center)
+                                            + abs(z[k]) * np.abs(D))
             curvature = np.abs(plus + minus - 2 * center)
             spread = np.abs(D - quotients[0])
             if not (np.all(curvature <= _AFFINE_RTOL * size * 8 * top + rounding)

@@ -80,7 +80,7 @@ def linearize(f, x_eq, u_eq=None, *, dt=None, check_equilibrium: bool = True,
     Accuracy: a column along which f is affine (a straight line: linear
     dynamics, a bilinear term, an input that enters linearly) is exact to
     rounding at any scale of the coefficients: the central difference is then
-    the same at every step, which three steps at the scale of (x*, u*) check
+    the same at every step, which four steps at the scale of (x*, u*) check
     (`_affine_column`), and the largest is taken. Every other column is the
     central difference (f(x + h e_k) - f(x - h e_k)) / 2h over a ladder of 30 steps halving from h = 1/4 (and, for
     |x_k| > 16, a second ladder from |x_k| / 4, used where it agrees),
