@@ -448,6 +448,18 @@ def _check_flat_plan(plan: FlatPlan, caller: str, x0, xT, *, angle: int | None =
     )
 
 
+def _zero_speed(v0: float, vT: float, pace: float | None = None) -> ValueError:
+    """The error for end speeds that are zero (to rounding beside the manoeuvre's `pace`) or of two signs."""
+    rounding = ("" if pace is None else f" (a speed within 1e-9 of the manoeuvre's pace, {pace:.3g} m/s "
+                "here, is zero to rounding)")
+    return ValueError(
+        f"speed must be nonzero and of the same sign at both ends: received v0 = {v0:g}, "
+        f"vT = {vT:g}{rounding}. A flat plan through zero speed is singular: the heading theta = "
+        "atan2(F2', F1') (2.97) is undefined when the robot stands still, so it cannot be set "
+        "by the boundary conditions. Start and end moving (e.g. speed=0.5), or turn on the "
+        "spot first with u1 = 0, u2 != 0 and plan from there.")
+
+
 def plan_robot(start, end, T, *, speed=1.0, L: float | None = None) -> FlatPlan:
     """Plan a manoeuvre of the two-wheeled robot (L=None) or of the car-like robot (wheelbase L).
 
@@ -455,7 +467,8 @@ def plan_robot(start, end, T, *, speed=1.0, L: float | None = None) -> FlatPlan:
     is the speed at both ends, or a pair (v0, vT). The flat output
     F = (x1, x2) gets cubic polynomials (2.31)-(2.38) with
     ``F'(0) = v0 (cos theta0, sin theta0)`` and ``F'(T) = vT (cos thetaT, sin thetaT)``,
-    so the pose is met at both ends. Both speeds must be nonzero and of one
+    so the pose is met at both ends. Both speeds must be nonzero (above 1e-9
+    of the manoeuvre's pace max(|end - start| / T, |v0|, |vT|)) and of one
     sign (negative: reversing): at zero speed the heading is undefined (the
     singularity of (2.97)-(2.101)). The smallest planned speed on [0, T] is
     found exactly (roots of d|F'|^2/dt) and stored as ``plan.min_speed``; a
@@ -469,18 +482,17 @@ def plan_robot(start, end, T, *, speed=1.0, L: float | None = None) -> FlatPlan:
     v = as_vector(speed, "speed")
     v0, vT = (v[0], v[0]) if v.size == 1 else tuple(as_vector(speed, "speed", size=2, why="(v0, vT)"))
     if v0 == 0 or vT == 0 or np.sign(v0) != np.sign(vT):
-        raise ValueError(
-            f"speed must be nonzero and of the same sign at both ends: received v0 = {v0:g}, "
-            f"vT = {vT:g}. A flat plan through zero speed is singular: the heading theta = "
-            "atan2(F2', F1') (2.97) is undefined when the robot stands still, so it cannot be set "
-            "by the boundary conditions. Start and end moving (e.g. speed=0.5), or turn on the "
-            "spot first with u1 = 0, u2 != 0 and plan from there."
-        )
+        raise _zero_speed(v0, vT)
     reverse = v0 < 0
     flat = two_wheeled_flatness(reverse) if L is None else car_like_flatness(L, reverse)
     S = [start[:2], v0 * np.array([np.cos(start[2]), np.sin(start[2])])]
     E = [end[:2], vT * np.array([np.cos(end[2]), np.sin(end[2])])]
     plan = plan_flat_output(flat, T, S, E)
+    # a speed that is rounding beside the manoeuvre's (0.1 - 0.1 m/s as 1.4e-17) is zero too: psi_x
+    # and psi_u divide by |F'|^2 and would give NaN, not this message
+    pace = max(float(np.hypot(*(end[:2] - start[:2]))) / T, abs(v0), abs(vT))
+    if min(abs(v0), abs(vT)) <= 1e-9 * pace:
+        raise _zero_speed(v0, vT, pace)
     _check_flat_plan(plan, "plan_robot", start, end, angle=2)
     t_min, plan.min_speed = _slowest_point(plan)
     if plan.min_speed <= 1e-6 * max(abs(v0), abs(vT)):

@@ -1,6 +1,8 @@
 """Flat outputs and the maps psi_x, psi_u (section 2.4)."""
 
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given, settings, strategies as st
@@ -121,6 +123,14 @@ def test_zero_speed_singularity_is_explained():
         ck.plan_robot([0, 0, 0], [3, 1, 0], 5.0, speed=0.0)
     with pytest.raises(ValueError, match=r"speed must be nonzero and of the same sign"):
         ck.plan_robot([0, 0, 0], [3, 1, 0], 5.0, speed=[1.0, -1.0])
+    # 0 m/s as np.arange(-2, 2.01, 0.1) gives it, 1.8e-15: zero to rounding, refused as 0 (it
+    # passed, and psi_x returned NaN with a warning about a missed start pose)
+    assert 0 < np.arange(-2, 2.01, 0.1)[20] < 1e-14
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(ValueError, match=r"speed must be nonzero.*zero to rounding"):
+            ck.plan_robot([0, 0, 0], [4, 2, np.pi / 2], 6.0, speed=np.arange(-2, 2.01, 0.1)[20])
+    assert ck.plan_robot([0, 0, 0], [4, 2, np.pi / 2], 6.0, speed=1e-6).min_speed > 0   # slow, not zero
     # straight back along the x1 axis: F1' goes from +1 to -1 and passes through zero
     with pytest.raises(ValueError, match=r"the planned path stops on the way"):
         ck.plan_robot([0, 0, 0], [-3, 0, np.pi], 5.0, speed=1.0)
