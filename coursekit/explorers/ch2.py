@@ -17,7 +17,7 @@ from ..simulation import simulate
 from ..style import PALETTE, course_subplots, curve_style
 from ..trajectory import feedforward, poly_trajectory
 from ._base import Explorer, int_slider, slider
-from .limits import rescale
+from .limits import rescale, scope_range
 
 __all__ = ["planner_compute", "time_shown", "planner_explorer", "robot_planner_compute",
            "robot_planner_explorer", "drive_robot"]
@@ -283,7 +283,9 @@ def robot_planner_explorer() -> Explorer:
         tu = r["t"][:r["u"].shape[0]]
         h["u1"].set_data(tu, r["u"][:, 0])
         h["u2"].set_data(tu, r["u"][:, 1])
-        _rescale_off_ticks(h["ax_u"], "y")
+        # the turn rate spans decades over the targets (0.5 rad/s ahead, 80 behind): limits from the
+        # 1-2-5 series, which a step of a target keeps (5 changes over x_T's 25 values, not 18)
+        scope_range(h["ax_u"], r["u"])
         rescale(h["ax_u"], axis="x", fill=1.0)   # the time axis: exactly [0, T] at rest
         # the data limits of the path axes from its points, start and target: not relim(), which
         # in newer matplotlib counts the arrow at a place that moves with the view, so the view
