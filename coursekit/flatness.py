@@ -488,8 +488,8 @@ def plan_robot(start, end, T, *, speed=1.0, L: float | None = None) -> FlatPlan:
     S = [start[:2], v0 * np.array([np.cos(start[2]), np.sin(start[2])])]
     E = [end[:2], vT * np.array([np.cos(end[2]), np.sin(end[2])])]
     plan = plan_flat_output(flat, T, S, E)
-    # a speed that is rounding beside the manoeuvre's (0.1 - 0.1 m/s as 1.4e-17) is zero too: psi_x
-    # and psi_u divide by |F'|^2 and would give NaN, not this message
+    # a speed that is rounding beside the manoeuvre's (0 m/s reached in steps of 0.1 from -2: 1.8e-15) is zero:
+    # psi_x and psi_u divide by |F'|^2 and would give NaN, not this message
     pace = max(float(np.hypot(*(end[:2] - start[:2]))) / T, abs(v0), abs(vT))
     if min(abs(v0), abs(vT)) <= 1e-9 * pace:
         raise _zero_speed(v0, vT, pace)
