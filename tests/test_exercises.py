@@ -346,7 +346,9 @@ from hypothesis.extra.numpy import arrays  # noqa: E402
 
 from coursekit.exercises._feedback import Report, matrix_feedback  # noqa: E402
 
-_entries = st.floats(-50, 50, allow_nan=False).filter(lambda v: abs(v) > 0.5).map(lambda v: round(v, 2))
+# entries of 0.51 to 50 either sign, drawn so, not filtered: hypothesis 6.80 (the oldest supported)
+# draws arrays' entries near 0 so often that a filter failed its health check
+_entries = st.tuples(st.sampled_from([-1.0, 1.0]), st.floats(0.51, 50.0)).map(lambda p: round(p[0] * p[1], 2))
 
 
 @given(expected=st.integers(2, 4).flatmap(lambda n: arrays(float, (n, n), elements=_entries)),
