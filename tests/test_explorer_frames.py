@@ -553,27 +553,27 @@ def test_a_drag_whose_frames_take_longer_than_the_settling_time_is_still_drawn_a
 def test_scope_range_takes_its_ends_from_the_1_2_5_series_and_moves_three_times_a_decade():
     ax = Figure().subplots()
     edge = limits.Y_EDGE
-    limits.scope_range(ax, [0.0, 0.3, 83.1, -1.35])          # 1.05 x 83.1 -> 100; below 0 a tenth
+    ch2._scope_range(ax, [0.0, 0.3, 83.1, -1.35])          # 1.05 x 83.1 -> 100; below 0 a tenth
     assert ax.get_ylim() == pytest.approx((-10 - edge * 110, 100 + edge * 110))
-    limits.scope_range(ax, [0.0, 83.1, -12.0])               # -12.6 -> -20
+    ch2._scope_range(ax, [0.0, 83.1, -12.0])               # -12.6 -> -20
     assert ax.get_ylim() == pytest.approx((-20 - edge * 120, 100 + edge * 120))
-    limits.scope_range(ax, [0.0, 1.0, 0.5])                  # 1.05 -> 2; nothing below 0: a tenth
+    ch2._scope_range(ax, [0.0, 1.0, 0.5])                  # 1.05 -> 2; nothing below 0: a tenth
     assert ax.get_ylim() == pytest.approx((-0.2 - edge * 2.2, 2 + edge * 2.2))
-    limits.scope_range(ax, [-3.0, -0.01])                    # all below 0: the top a tenth of 5
+    ch2._scope_range(ax, [-3.0, -0.01])                    # all below 0: the top a tenth of 5
     assert ax.get_ylim() == pytest.approx((-5 - edge * 5.5, 0.5 + edge * 5.5))
     ends = []
     for peak in np.geomspace(1.0, 1000.0, 61):               # three decades in steps of 12 %
-        limits.scope_range(ax, [0.0, peak])
+        ch2._scope_range(ax, [0.0, peak])
         ends.append(ax.get_ylim())
     assert sum(a != b for a, b in zip(ends, ends[1:])) == 9
     kept = ax.get_ylim()
-    limits.scope_range(ax, [np.nan, np.inf])                 # nothing finite: kept
+    ch2._scope_range(ax, [np.nan, np.inf])                 # nothing finite: kept
     assert ax.get_ylim() == kept
-    limits.scope_range(ax, [0.0, 0.0])                       # all zero: -1 to 1
+    ch2._scope_range(ax, [0.0, 0.0])                       # all zero: -1 to 1
     assert ax.get_ylim() == pytest.approx((-1 - edge * 2, 1 + edge * 2))
     with limits.moving():                                    # a hand moves: rescale's growing limits
         line, = ax.plot([0, 1], [0, 0.5])
-        limits.scope_range(ax, [0.0, 0.5])
+        ch2._scope_range(ax, [0.0, 0.5])
         assert ax.get_ylim() == pytest.approx((-1 - edge * 2, 1 + edge * 2))
 
 

@@ -116,15 +116,14 @@ class Explorer:
         from ..style import COURSE_STYLE, fit_margins, is_lecture_mode
         self._check(title, controls, dict(compute=compute, draw=draw, update=update, readout=readout))
         self.title, self.controls = title, dict(controls)
-        self._compute, self._update, self._readout = compute, update, readout
+        self._update, self._readout = update, readout    # compute: through the cache below
         self._results = functools.lru_cache(maxsize=128)(lambda settings: compute(**dict(settings)))
         self.lecture = is_lecture_mode()
         self.fig = fit_margins(Figure(figsize=figsize or rcParams["figure.figsize"]))
         self.natural_dpi = float(self.fig.dpi)
         with rc_context(COURSE_STYLE):     # the course's colours and a line style per curve
             self.handles = draw(self.fig)
-        self.screen: dict = {}
-        self.error: str | None = None
+        self.screen, self.error = {}, None     # the room reported by the view; why a setting failed
         try:
             self.apply(self.params)
         except Exception as error:   # noqa: BLE001 - the user's function, named in the message

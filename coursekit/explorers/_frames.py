@@ -76,14 +76,11 @@ class FrameRenderer:
             self._draw_animated()
             self.blits += 1
 
-    def _parents(self):
-        return (*self.fig.axes, self.fig)
-
     def _children(self):
         """What can move: the axes' and the figure's children but the axes, their axis and patch."""
         from matplotlib.axes import Axes
         from matplotlib.axis import Axis
-        for parent in self._parents():
+        for parent in (*self.fig.axes, self.fig):
             yield from (a for a in parent.get_children()
                         if a is not parent.patch and not isinstance(a, (Axes, Axis)))
 
@@ -106,7 +103,7 @@ class FrameRenderer:
         out, key = [], (self._text(), tuple(ax.get_position().bounds for ax in self.fig.axes))
         if key != self._meets_key:
             self._meets_key, self._meets = key, {}
-        for parent in self._parents():
+        for parent in (*self.fig.axes, self.fig):
             order = sorted((a for a in parent.get_children() if a is not parent.patch), key=attrgetter("zorder"))
             first = next((i for i, a in enumerate(order) if a in self.moving), None)
             if first is not None:

@@ -17,7 +17,7 @@ from ..simulation import simulate
 from ..style import PALETTE, course_subplots, curve_style
 from ..trajectory import feedforward, poly_trajectory
 from ._base import Explorer, int_slider, slider
-from .limits import rescale, scope_range
+from .limits import Y_EDGE, is_moving, rescale, round_value
 
 __all__ = ["planner_compute", "time_shown", "planner_explorer", "robot_planner_compute",
            "robot_planner_explorer", "drive_robot"]
@@ -82,8 +82,7 @@ def time_shown(T: float) -> float:
     the time axis (a redraw of the curves alone) but where 2 T passes one of them."""
     T = as_scalar(T, "T", positive=True, limit=MAX_SPAN / 3,
                   limit_why=f"the move is shown for up to 3 T, and a time grid spans at most {MAX_SPAN:g} s")
-    step = 10.0 ** math.floor(math.log10(T))
-    step *= max(d for d in (1.0, 2.0, 5.0) if d * step <= T * (1 + 1e-12))
+    step = round_value(T)
     return math.ceil(2.0 * T / step - 1e-9) * step
 
 
@@ -231,6 +230,28 @@ def _rescale_off_ticks(ax, names: str, **kwargs) -> None:
             getattr(ax, f"set_{name}lim")(low - 0.05 * (high - low), high + 0.05 * (high - low))
 
 
+def _scope_range(ax, values, *, share: float = 0.1) -> None:
+    """The vertical view of `ax` for `values` as an oscilloscope's range switch sets it: each end at
+    the smallest of 1, 2, 5 times a power of ten at least 1.05 times the data's reach that side of
+    0 and `share` of the other end, then `Y_EDGE` of the span out. For data whose size changes by
+    decades as a slider moves (the turn rate: 0.5 to 80 rad/s), where `rescale`'s round steps move
+    at nearly every step: these move about 3 times a decade. While a control moves, `rescale`'s
+    growing limits; no finite value: kept."""
+    values = np.asarray(values, dtype=float)
+    values = values[np.isfinite(values)]
+    if is_moving():
+        return rescale(ax)
+    if values.size == 0:
+        return
+    top, bottom = 1.05 * max(values.max(), 0.0), 1.05 * max(-values.min(), 0.0)
+    high, low = (round_value(end, up=True) if end > 0 else 0.0
+                 for end in (max(top, share * bottom), max(bottom, share * top)))
+    if high == low == 0.0:
+        high = low = 1.0
+    edge = Y_EDGE * (high + low)
+    ax.set_ylim(-low - edge, high + edge)
+
+
 def _same_scale(ax) -> None:
     """Widen the narrower of the axes' limits about its middle, so that a metre is as long on
     x2 as on x1 in the box of fixed aspect: limits set from the data alone (`rescale`), not by
@@ -285,7 +306,7 @@ def robot_planner_explorer() -> Explorer:
         h["u2"].set_data(tu, r["u"][:, 1])
         # the turn rate spans decades over the targets (0.5 rad/s ahead, 80 behind): limits from the
         # 1-2-5 series, which a step of a target keeps (5 changes over x_T's 25 values, not 18)
-        scope_range(h["ax_u"], r["u"])
+        _scope_range(h["ax_u"], r["u"])
         rescale(h["ax_u"], axis="x", fill=1.0)   # the time axis: exactly [0, T] at rest
         # the data limits of the path axes from its points, start and target: not relim(), which
         # in newer matplotlib counts the arrow at a place that moves with the view, so the view

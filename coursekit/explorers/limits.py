@@ -7,7 +7,6 @@ or 5 times a power of ten) no larger than the padding, so that stepping a slider
 limits only every few steps; a vertical axis then gains `Y_EDGE` of its span either way (no tick
 label on the frame's corner). While a control moves (drawn inside `moving`) the limits only grow,
 leaving the data `MOVING_FILL` of them and `Y_EDGE` / 2 of a vertical span off the frame.
-`scope_range` is the coarser policy for data whose size changes by decades as a slider moves.
 """
 
 from __future__ import annotations
@@ -20,7 +19,7 @@ import numpy as np
 
 from .._validation import as_scalar
 
-__all__ = ["rescale", "scope_range", "moving", "is_moving", "SETTLE_S", "MOVING_FILL", "Y_EDGE"]
+__all__ = ["rescale", "round_value", "moving", "is_moving", "SETTLE_S", "MOVING_FILL", "Y_EDGE"]
 
 #: seconds between moves of a control that make them one drag; a frame follows once it rests
 SETTLE_S = 0.3
@@ -68,39 +67,10 @@ def rescale(*axes, axis: str = "y", min_span: float = 0.0, fill: float = 0.8, re
             _fit(ax, name, min_span, fill)
 
 
-def scope_range(ax, values, *, share: float = 0.1) -> None:
-    """Fit the vertical view of `ax` to `values` as an oscilloscope's range switch would: each end
-    at the smallest of 1, 2, 5 times a power of ten at least 1.05 times the data's reach that side
-    of 0, and at least `share` of the other end (0 stays in view), then `Y_EDGE` of the span out.
-    For data whose size changes by decades as a slider moves (a turn rate from 0.5 to 80 rad/s),
-    where `rescale`'s round steps move at nearly every step: these move about 3 times a decade.
-    While a control moves (inside `moving`), `rescale`'s growing limits; no finite value: kept."""
-    values = np.asarray(values, dtype=float)
-    values = values[np.isfinite(values)]
-    if is_moving():
-        return rescale(ax)
-    if values.size == 0:
-        return
-    top, bottom = 1.05 * max(values.max(), 0.0), 1.05 * max(-values.min(), 0.0)
-    high, low = _series_up(max(top, share * bottom)), _series_up(max(bottom, share * top))
-    if high == low == 0.0:
-        high = low = 1.0
-    edge = Y_EDGE * (high + low)
-    ax.set_ylim(-low - edge, high + edge)
-
-
-def _series_up(value: float) -> float:
-    """The smallest of 1, 2, 5 times a power of ten that is at least `value` (0 for 0)."""
-    if value <= 0:
-        return 0.0
-    power = 10.0 ** math.floor(math.log10(value))
-    return min(d * power for d in (1.0, 2.0, 5.0, 10.0) if d * power >= value * (1 - 1e-12))
-
-
-def _round_step(pad: float) -> float:
-    """The largest of 1, 2, 5 times a power of ten that is at most `pad` (> 0)."""
-    power = 10.0 ** math.floor(math.log10(pad))
-    return power * max(d for d in (1.0, 2.0, 5.0, 10.0) if d * power <= pad * (1 + 1e-12))
+def round_value(value: float, up: bool = False) -> float:
+    """The largest of 1, 2, 5 times a power of ten at most `value` > 0 (`up`: the smallest at least it)."""
+    series = 10.0 ** math.floor(math.log10(value)) * np.array([1.0, 2.0, 5.0, 10.0])
+    return float(series[series >= value * (1 - 1e-12)].min() if up else series[series <= value * (1 + 1e-12)].max())
 
 
 def _at_rest(lo: float, hi: float, fill: float, edge: float) -> tuple[float, float]:
@@ -109,7 +79,7 @@ def _at_rest(lo: float, hi: float, fill: float, edge: float) -> tuple[float, flo
     pad = (hi - lo) * (1 / fill - 1) / 2
     if pad <= 0:
         return lo, hi
-    step = _round_step(pad)
+    step = round_value(pad)
     low, high = math.floor((lo - pad) / step + 1e-9) * step, math.ceil((hi + pad) / step - 1e-9) * step
     return low - edge * (high - low), high + edge * (high - low)
 
