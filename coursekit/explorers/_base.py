@@ -116,7 +116,7 @@ class Explorer:
         from ..style import COURSE_STYLE, fit_margins, is_lecture_mode
         self._check(title, controls, dict(compute=compute, draw=draw, update=update, readout=readout))
         self.title, self.controls = title, dict(controls)
-        self._update, self._readout = update, readout    # compute: through the cache below
+        self._compute, self._update, self._readout = compute, update, readout
         self._results = functools.lru_cache(maxsize=128)(lambda settings: compute(**dict(settings)))
         self.lecture = is_lecture_mode()
         self.fig = fit_margins(Figure(figsize=figsize or rcParams["figure.figsize"]))
