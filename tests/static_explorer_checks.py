@@ -13,6 +13,11 @@ folder its frames are read from, and for every explorer on it
   region announces the figure once the slider rests, and the figure shown is, pixel for pixel,
   the one the explorer renders in this process for the settings the slider snapped to
   (`test_static_explorers.assert_shows`).
+
+A page whose explorers run the same script over data made the same way as a page checked in full
+(the student edition, byte for byte the instructor's; the slides, drawn for the screen rather than
+the column) is checked with less (`check_page`'s `every_state`): one key step, every frame on the
+disk, one drag.
 """
 
 from __future__ import annotations
@@ -153,14 +158,18 @@ def _drag(page, root, j: int, count: int) -> dict:
     return before
 
 
-def check_page(page, folder: Path, *, column: bool, scroll=None, every_state: bool = True) -> int:
+def check_page(page, folder: Path, *, column: bool, scroll=None, every_state: bool = True,
+               render: bool | None = None) -> int:
     """Check every explorer of the chapter `page` shows (see the module's doc); its frames are
     files of `folder` (the page's own folder), drawn for the website's column when `column`.
     `scroll(root)` brings an explorer into view (default: scroll it into view). Without
-    `every_state` (for a page whose explorers hold the same data and frames as a page checked with
-    it, `explorer_data`), the keyboard's walk through every state is left out, and only each
-    explorer's first slider is dragged, its figure compared with the frame file the data names
-    rather than rendered again. Returns how many explorers were checked."""
+    `every_state` (for a page whose explorers run the same script over data of the same kind as a
+    page checked with it), the keyboard's walk through every state is left out: one key step of
+    the first slider is checked instead, every frame file the data names is checked to be on the
+    disk and readable, and only the first slider is dragged; its figure is compared with the frame
+    file the data names and, with `render` (default: `every_state`; for frames not checked
+    elsewhere), with the figure the explorer renders in this process. Returns how many explorers
+    were checked."""
     from test_static_explorers import assert_shows    # the figure a fresh explorer shows after one move
     roots = page.locator(".ck-static-explorer")
     for n in range(roots.count()):
@@ -172,11 +181,14 @@ def check_page(page, folder: Path, *, column: bool, scroll=None, every_state: bo
         title = root.locator(".ck-static-title").inner_text().strip()
         factory, explorer = _explorers_by_title()[title]
         _names(explorer, data)
+        ranges = [j for j, control in enumerate(data["controls"]) if control["kind"] == "range"]
         if every_state:
             shown: list = []
             _step_everywhere(page, root, data, shown)
             assert set(shown) <= {tuple(map(int, k.split(","))) for k in data["script"]["states"]}
-        ranges = [j for j, control in enumerate(data["controls"]) if control["kind"] == "range"]
+        else:
+            _frames_on_disk(folder, data)
+            _key_step(page, root, data, ranges[0])
         for j in ranges if every_state else ranges[:1]:
             control = data["controls"][j]
             for k, c in enumerate(data["controls"]):
@@ -195,14 +207,39 @@ def check_page(page, folder: Path, *, column: bool, scroll=None, every_state: bo
             settings = {c["name"]: c["values"][i] for c, i in zip(data["controls"], after["state"])}
             frame = _pixels(folder / after["src"])
             assert list(frame.shape[1::-1]) == after["natural"]
-            if every_state:
-                alt = assert_shows(factory, settings, frame, column=column)
-                assert after["alt"] == alt, (after["alt"], alt)
-            else:
+            if not every_state:
                 named = data["script"]["frames"][data["script"]["states"][",".join(map(str, after["state"]))]]
                 assert (after["src"], after["alt"]) == (named["src"], named["alt"]), (after, named)
                 assert _settings_text(data, after["state"]) in after["alt"], (after["state"], after["alt"])
+            if every_state if render is None else render:
+                alt = assert_shows(factory, settings, frame, column=column)
+                assert after["alt"] == alt, (after["alt"], alt)
     return roots.count()
+
+
+def _frames_on_disk(folder: Path, data: dict) -> None:
+    """Every state the data stores names a frame, and every frame is a readable image file of
+    `folder` (what the keyboard's walk through every state would load)."""
+    frames = data["script"]["frames"]
+    assert sorted(set(data["script"]["states"].values())) == list(range(len(frames))), "a frame no state shows"
+    for frame in frames:
+        with Image.open(folder / frame["src"]) as image:
+            assert image.size[0] > 0 and image.size[1] > 0, frame["src"]
+
+
+def _key_step(page, root, data: dict, j: int) -> None:
+    """One arrow key on range input `j` (focused) moves it one value and shows that state's frame,
+    loaded, with its settings in the alt text."""
+    control = data["controls"][j]
+    root.locator("[data-ck-control]").nth(j).focus()
+    before = root.evaluate(_STATE_JS)
+    key, step = ("ArrowLeft", -1) if before["state"][j] == len(control["values"]) - 1 else ("ArrowRight", 1)
+    page.keyboard.press(key)
+    page.wait_for_function("r => { const i = r.querySelector('img.ck-static-figure'); "
+                           "return i.complete && i.naturalWidth > 0; }", arg=root.element_handle(), timeout=10_000)
+    after = root.evaluate(_STATE_JS)
+    assert after["state"][j] == before["state"][j] + step and after["src"] != before["src"], (before, after)
+    assert _settings_text(data, after["state"]) in after["alt"], (after["state"], after["alt"])
 
 
 def explorer_data(page, folder: Path) -> list:

@@ -300,8 +300,9 @@ class Opened:
     """A page opened from the disk; every request that is not a file of the disk is refused and
     recorded (`outside`), as is every file that fails to load (`failed`) and every console error.
 
-    axe-core runs last: it reads the text of the style sheets with requests that Chromium refuses
-    to a page opened from the disk (failures and console errors of axe's own, not of the slides).
+    axe-core reads the text of the style sheets with requests that Chromium refuses to a page
+    opened from the disk: the failures and console errors while it runs are axe's own, not the
+    slides', and are not kept.
     """
 
     def __init__(self, browser, url: str, viewport: dict | None = None):
@@ -330,7 +331,28 @@ class Opened:
         assert self.errors == [], f"console errors: {self.errors}"
 
     def axe(self, selector: str) -> list[str]:
-        return lab_harness.axe_violations(self.page, selector, lab_harness.axe_source())
+        failed, errors = len(self.failed), len(self.errors)
+        found = lab_harness.axe_violations(self.page, selector, lab_harness.axe_source())
+        del self.failed[failed:], self.errors[errors:]
+        return found
+
+
+@pytest.fixture(scope="module")
+def chapter(course, chromium):
+    """``chapter(path)``: the slides of chapter `path` in a 1,280 x 800 window, opened once for the
+    module, reveal.js started (a chapter takes seconds to load and typeset; the tests that read it
+    as loaded run before those that move its sliders or its slides, in the order of this file)."""
+    views = {}
+
+    def open_chapter(path):
+        if path not in views:
+            views[path] = Opened(chromium, (course / f"{path.stem}{slideshow.SUFFIX}").as_uri())
+            views[path].wait_for_reveal()
+        return views[path]
+
+    yield open_chapter
+    for view in views.values():
+        view.context.close()
 
 
 @pytest.fixture
@@ -373,10 +395,9 @@ FIGURE_REPORT = """() => ({
 
 @pytest.mark.browser
 @pytest.mark.parametrize("path", CHAPTERS, ids=lambda p: p.stem)
-def test_chapter_slides_work_offline_with_each_equation_typeset_once(path, course, opened):
+def test_chapter_slides_work_offline_with_each_equation_typeset_once(path, course, chapter):
     slides = course / f"{path.stem}{slideshow.SUFFIX}"
-    view = opened(slides.as_uri())
-    view.wait_for_reveal()
+    view = chapter(path)
     view.page.evaluate("MathJax.startup.promise.then(() => true)")
     view.assert_offline_and_clean()
     # equations: every TeX source of the page rendered, once, in place; no MathJax 2 preview
@@ -448,13 +469,17 @@ def _show_slide(view):
 
 @pytest.mark.browser
 @pytest.mark.parametrize("path", CHAPTERS, ids=lambda p: p.stem)
-def test_explorers_are_live_on_the_slides(path, course, opened):
-    """On its slide, every state a reader reaches shows its frame; dragging each slider swaps the
+def test_explorers_are_live_on_the_slides(path, course, chapter):
+    """On its slide, each explorer loads, an arrow key steps its first slider (and not the
+    slides), every frame its data names is on the disk, and a drag of its first slider swaps the
     figure and its alt text once per value passed and ends on the figure the explorer renders for
-    those settings (`static_explorer_checks`); the arrow keys move the slider, not the slides."""
-    view = opened((course / f"{path.stem}{slideshow.SUFFIX}").as_uri())
-    view.wait_for_reveal()
-    checked = static_explorer_checks.check_page(view.page, course, column=False, scroll=_show_slide(view))
+    those settings. The explorers' script and the making of their data are those of the website,
+    whose instructor edition's check walks through every state and drags every slider
+    (`static_explorer_checks`); the slides' frames, drawn for the screen, are compared with the
+    explorer's own figure here and in tests/test_static_explorers.py."""
+    view = chapter(path)
+    checked = static_explorer_checks.check_page(view.page, course, column=False, scroll=_show_slide(view),
+                                                every_state=False, render=True)
     assert checked == sum(bool(re.search(r"\b\w+_explorer\(", c.source))
                           for c in read_notebook(path).cells if c.cell_type == "code") > 0
     # the arrow keys pressed on the last explorer's sliders left its slide on screen
@@ -484,12 +509,12 @@ FIT_REPORT = """() => Reveal.getSlides().map(slide => {
 
 @pytest.mark.browser
 @pytest.mark.parametrize("path", CHAPTERS, ids=lambda p: p.stem)
-def test_every_slide_fits_a_1280_by_720_screen(path, course, opened):
+def test_every_slide_fits_a_1280_by_720_screen(path, course, chapter):
     """Each slide shows all it holds on a 1280 x 720 screen, without scrolling: a sub-slide too
     long for it is cut into several, and a block too tall by itself is shown a little smaller."""
-    view = opened((course / f"{path.stem}{slideshow.SUFFIX}").as_uri(), viewport={"width": 1280, "height": 720})
-    view.wait_for_reveal()
-    view.page.evaluate("Reveal.configure({transition: 'none'})")
+    view = chapter(path)
+    view.page.set_viewport_size({"width": 1280, "height": 720})
+    view.page.evaluate("() => { Reveal.configure({transition: 'none'}); Reveal.layout(); }")
     slides = view.page.evaluate(FIT_REPORT)
     too_tall = [s for s in slides if s["past"] > 0 or s["off"] > 0]     # not a pixel past
     assert not too_tall, f"{len(too_tall)} of {len(slides)} slides do not fit: {too_tall}"
