@@ -1,21 +1,23 @@
 """A real-browser test: JupyterLab + headless Chromium driven by Playwright.
 
-For each chapter notebook: open it in JupyterLab, Run > Run All Cells, wait until the kernel is
-done, assert that no cell shows a traceback, then move the first slider of an
-explorer with the keyboard and assert that the explorer's figure changes.
+For each chapter notebook: open it in JupyterLab, Run > Run All Cells, wait
+until the kernel is done, assert that no cell shows a traceback, then move the
+first slider of an explorer with the keyboard and assert that the explorer's
+figure changes.
 
 Then what a student feels when dragging a slider, on a small demo explorer
-(which also tests the harness itself) and on a real one (the mass-spring-damper of chapter 1): during a slow drag the
-figure follows (it changes at least twice before the mouse is released); after
-the release the figure shown is the one the explorer computes for the value
-the slider shows (pixel for pixel, against the explorer's figure computed and
-drawn whole again in the kernel for its final parameters); with a chapter
-open, the kernel does no work while nobody touches a control; and nothing anywhere reports an error (no
-traceback or stderr in a cell, no error or stderr message from the kernel,
-widget callbacks included, no uncaught error in the page). Nothing here
-asserts a time; ``python benchmarks/run.py --browser`` measures them. In Notebook 7 (served by
-the same server), arrow keys, Home and End on a focused slider step it and leave the notebook's
-cell selection alone.
+(which also tests the harness itself) and on a real one (the mass-spring-damper
+of chapter 1): during a slow drag the figure follows (it changes at least
+twice before the mouse is released); after the release the figure shown is
+the one the explorer computes for the value the slider shows (pixel for pixel,
+against the explorer's figure computed and drawn whole again in the kernel for
+its final parameters); with a chapter open, the kernel does no work while
+nobody touches a control; and nothing anywhere reports an error (no traceback
+or stderr in a cell, no error or stderr message from the kernel, widget
+callbacks included, no uncaught error in the page). Nothing here asserts a
+time; ``python benchmarks/run.py --browser`` measures them. In Notebook 7
+(served by the same server), arrow keys, Home and End on a focused slider step
+it and leave the notebook's cell selection alone.
 
 Needs Playwright for Python (``pip install playwright``, part of the dev extra)
 and the system Chromium (Debian package ``chromium``; no browser download).
@@ -476,7 +478,8 @@ _CELLS_JS = """() => {
 
 
 #: whether a cell of the notebook was queued or run (its prompt shows * or a number)
-_RAN_JS = "() => [...document.querySelectorAll('.jp-Notebook .jp-InputPrompt')].some(p => /\\[[*\\d]/.test(p.textContent))"
+_RAN_JS = ("() => [...document.querySelectorAll('.jp-Notebook .jp-InputPrompt')]"
+           ".some(p => /\\[[*\\d]/.test(p.textContent))")
 
 
 def test_keys_on_a_focused_slider_step_it_and_never_reach_notebook_7_s_shortcuts(lab, page):
