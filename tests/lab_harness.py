@@ -514,22 +514,25 @@ _MARK_REPEATED_CODE_JS = """selector => {
 }"""
 
 
-def axe_violations(page, selector: str, source: str) -> list[str]:
+def axe_violations(page, selector: str, source: str, *, preload: bool = True) -> list[str]:
     """axe-core's WCAG 2.1 A/AA violations inside the elements `selector` matches, one line each.
     Every rule runs on every element but the token spans of highlighted code drawn like one that
     axe checks (`_MARK_REPEATED_CODE_JS`: the same contrast; a token span is only text, which the
     other rules do not look at); ``resultTypes`` only spares axe listing each element that passed
-    (30 to 50 % of its time on a page of 600 sections)."""
+    (30 to 50 % of its time on a page of 600 sections). Without `preload` axe does not fetch the
+    page's style sheets (for its CSS orientation rule): on a page opened from the disk Chromium
+    refuses those fetches anyway, and each refusal would be a failed request and a console error
+    of the page, which may arrive after axe has returned."""
     page.add_script_tag(content=source)
     page.evaluate(_MARK_REPEATED_CODE_JS, selector)
-    found = page.evaluate("""async selector => {
+    found = page.evaluate("""async ([selector, preload]) => {
         axe.configure({rules: [{id: 'color-contrast', selector: '*:not([data-ck-axe-repeat])'}]});
         const result = await axe.run(Array.from(document.querySelectorAll(selector)),
             {runOnly: {type: 'tag', values: ['wcag2a', 'wcag2aa', 'wcag21a', 'wcag21aa']},
-             resultTypes: ['violations']});
+             resultTypes: ['violations'], preload});
         for (const span of document.querySelectorAll('[data-ck-axe-repeat]'))
             span.removeAttribute('data-ck-axe-repeat');
         return result.violations.map(v => `${v.id}: ${v.help} (${v.nodes.length} elements, e.g. `
             + `${v.nodes[0].html.slice(0, 160)})`);
-    }""", selector)
+    }""", [selector, preload])
     return list(found)
