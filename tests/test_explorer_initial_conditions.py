@@ -16,7 +16,7 @@ import pytest
 from coursekit.explorers.ch1 import EULER_EXAMPLES
 from coursekit.tools.chapters import explorer_factories
 from bad_input_cases import CHAPTER_CASES
-from test_figure_layout import settings
+from test_figure_layout import settings, undrawn
 
 EXPLORERS = explorer_factories()
 
@@ -85,8 +85,7 @@ def test_every_explorer_states_its_initial_conditions_here():
 
 @pytest.mark.parametrize("name", EXPLORERS)
 def test_each_curve_starts_at_the_initial_condition_its_control_or_text_states(name):
-    explorer = EXPLORERS[name]()
-    explorer.frames.frame = lambda: explorer.png     # the curves' data only: the figure need not be drawn
+    explorer = undrawn(EXPLORERS[name]())     # the curves' data only
     found = []
     for setting in settings(explorer.controls, every_end=True):
         for control, value in setting.items():

@@ -133,6 +133,13 @@ def test_plotting_helper_figure_has_no_text_problems(name, style_name):
 EXPLORERS = {f.__name__: f for f in explorer_factories().values()}
 
 
+def undrawn(explorer):
+    """`explorer`, its refreshes computing and updating the artists without drawing a frame: for
+    the sweeps that read texts and data, or draw the figure themselves. Returns it."""
+    explorer.frames.frame = lambda: explorer.png
+    return explorer
+
+
 def settings(controls, *, every_end: bool):
     """Control settings to check: the defaults, and all sliders at their minima, then at their
     maxima, at once; with `every_end` also each control at each end (each option of a dropdown)
@@ -158,8 +165,7 @@ EVERY_END = "font size 18"
 def test_explorer_figure_has_no_text_problems_over_its_slider_range(name, style_name):
     found = []
     with style(style_name):
-        explorer = EXPLORERS[name]()
-        explorer.frames.frame = lambda: explorer.png     # text_problems draws the figure itself
+        explorer = undrawn(EXPLORERS[name]())     # text_problems draws the figure itself
         for setting in settings(explorer.controls, every_end=style_name == EVERY_END):
             for control, value in setting.items():
                 explorer.controls[control].value = value
