@@ -1,6 +1,7 @@
 """A real-browser test: JupyterLab + headless Chromium driven by Playwright.
 
-For each chapter notebook: open it in JupyterLab, Run > Run All Cells, wait
+For each chapter notebook: open it in JupyterLab and assert that, untouched, it
+is not marked modified once its kernel is connected, Run > Run All Cells, wait
 until the kernel is done, assert that no cell shows a traceback, then move the
 first slider of an explorer with the keyboard and assert that the explorer's
 figure changes.
@@ -111,6 +112,36 @@ _CPU_CODE = "import resource as _r; _u = _r.getrusage(_r.RUSAGE_SELF); print(_u.
 IDLE_S = 8                   # how long the kernel is watched while nobody touches a control
 
 
+# once JupyterLab has written the kernel's metadata into the model of the notebook `path` (it
+# does so on connecting; an equal value changes nothing): whether the notebook is modified, as
+# its tab shows it, and the metadata of the model and of the kernel
+_CONNECTED_STATE_JS = """async path => {
+    const widget = Array.from(window.jupyterapp.shell.widgets('main')).find(w => w.context?.path === path);
+    const kernel = widget.sessionContext.session.kernel;
+    const [info, spec] = [await kernel.info, await kernel.spec];
+    const canonical = value => JSON.stringify(value, (key, v) => v && typeof v === 'object' && !Array.isArray(v)
+        ? Object.fromEntries(Object.entries(v).sort()) : v);
+    const model = widget.context.model;
+    for (let wait = 0; wait < 100; wait++) {
+        if (canonical(model.getMetadata('language_info')) === canonical(info.language_info)
+                && model.getMetadata('kernelspec')?.display_name === spec.display_name) { break; }
+        await new Promise(resolve => setTimeout(resolve, 100));
+    }
+    const tab = Array.from(document.querySelectorAll('.lm-DockPanel-tabBar .lm-TabBar-tab'))
+        .find(t => t.dataset.id === widget.id);
+    return {dirty: tab.classList.contains('jp-mod-dirty'), modelDirty: model.dirty,
+            kernelspec: model.getMetadata('kernelspec'), language_info: model.getMetadata('language_info'),
+            version: info.language_info.version};
+}"""
+
+
+def _changed(stored: dict, shown: dict) -> list[str]:
+    """The metadata fields JupyterLab changed: 'kernelspec.display_name', 'language_info.version', ..."""
+    return sorted(f"{key}.{field}" for key in ("kernelspec", "language_info")
+                  for field in set(stored.get(key, {})) | set(shown.get(key) or {})
+                  if stored.get(key, {}).get(field) != (shown.get(key) or {}).get(field))
+
+
 def _chapter_notebooks() -> list[str]:
     return [p.name for p in chapter_notebooks(NOTEBOOKS)]
 
@@ -178,6 +209,7 @@ def test_notebook_runs_in_jupyterlab_and_its_explorer_answers(name, page, opened
     t0 = time.monotonic()
     with opened(name):
         t_open = time.monotonic() - t0
+        _assert_opened_unmodified(page, name)
         prompts = _run_without_errors(page, name)
         t_run = time.monotonic() - t0 - t_open
         assert len(prompts) == _count_code_cells(name), (
@@ -210,6 +242,25 @@ def test_notebook_runs_in_jupyterlab_and_its_explorer_answers(name, page, opened
             print(f"\n[browser] {name}: open {t_open:.1f} s, run all {t_run:.1f} s "
                   f"({len(prompts)} code cells), kernel CPU while idle {idle_cpu:.2f} s in {IDLE_S} s, "
                   f"slider -> new figure {t_slider:.1f} s")
+
+
+def _assert_opened_unmodified(page, name: str) -> None:
+    """The chapter, opened untouched, is not modified once its kernel is connected: no unsaved mark
+    on its tab, so closing it would not ask to save. JupyterLab writes the kernel's metadata into
+    the notebook on connecting, so this holds when the notebooks store the metadata of this kernel
+    (coursekit/tools/kernel_metadata.py). With a kernel of another Python version it cannot hold
+    (the version is part of that metadata, jupyter/notebook#2123): then the version must be all
+    JupyterLab changed."""
+    stored = json.loads((NOTEBOOKS / name).read_text(encoding="utf-8"))["metadata"]
+    state = page.evaluate(_CONNECTED_STATE_JS, name)
+    changed = _changed(stored, state)
+    stored_version = stored.get("language_info", {}).get("version")
+    if stored_version is not None and state["version"] != stored_version:
+        assert changed == ["language_info.version"], (
+            f"{name}: opening it changed {changed}; with a kernel of another Python only the version may differ")
+        return
+    assert not changed, f"{name}: JupyterLab changed the stored metadata {changed} on opening it"
+    assert not state["dirty"] and not state["modelDirty"], f"{name}: marked modified though untouched"
 
 
 def _first_explorer(page, selector: str, prop: str) -> str:

@@ -1,4 +1,4 @@
-"""How JupyterLab shows the notebooks, in headless Chromium: lecture mode and opening untouched.
+"""How JupyterLab shows the notebooks, in headless Chromium: lecture mode, reopened explorers.
 
 * ``ck.lecture_mode()`` run in a cell enlarges the notebook's own text: the computed font size
   of a markdown paragraph, a code cell, a text output and a widget label grows by half, and
@@ -9,22 +9,17 @@
 * a comm opened just before its kernel connection goes away (as when a test closes a notebook
   while the widget manager opens its control comm) makes JupyterLab report its cancelled
   subshell request as an uncaught page error: the harness sets that one aside
-  (`lab_harness.teardown_page_error`) and still reports any other uncaught error;
-* each chapter notebook opened untouched stays unmodified once its kernel is connected (no
-  unsaved mark on its tab) and closes without the "Save your work" dialog. JupyterLab writes
-  the kernel's metadata into the notebook on connecting, so this holds when the notebooks store
-  the metadata of this kernel (coursekit/tools/kernel_metadata.py). With a kernel of another
-  Python version it cannot hold (the version is part of that metadata, jupyter/notebook#2123):
-  the test then checks that the version is all JupyterLab changed, and is skipped saying so.
+  (`lab_harness.teardown_page_error`) and still reports any other uncaught error.
+
+That each chapter opened untouched stays unmodified is checked where tests/test_browser.py opens
+it to run it.
 
 Runs like tests/test_browser.py (marker ``browser``; skipped when Playwright or Chromium is missing).
 """
 
 from __future__ import annotations
 
-import json
 import re
-import shutil
 import time
 from pathlib import Path
 
@@ -32,12 +27,9 @@ import nbformat
 import pytest
 
 import lab_harness as lab_h
-from coursekit.tools.notebooks import chapter_notebooks
 
 pytestmark = pytest.mark.browser
 
-NOTEBOOKS = Path(__file__).parents[1] / "notebooks"
-UNTOUCHED = "untouched"          # the folder of the served copies that no test runs or saves
 LECTURE = "lecture_text.ipynb"
 LECTURE_CELLS = [
     nbformat.v4.new_markdown_cell("## Lecture mode\n\nA paragraph the back row should read: the closed "
@@ -68,14 +60,12 @@ REOPENED_CELLS = ["%matplotlib inline\nfrom coursekit.explorers.ch1 import euler
 
 @pytest.fixture(scope="module")
 def page(tmp_path_factory):
-    """JupyterLab serving the lecture-mode notebook and untouched copies of the chapters."""
+    """JupyterLab serving the lecture-mode, reopened-explorers and teardown notebooks."""
     reason = lab_h.missing_reason()
     if reason:
         pytest.skip(reason)
     base = tmp_path_factory.mktemp("lab")
-    (base / "root" / UNTOUCHED).mkdir(parents=True)
-    for path in chapter_notebooks(NOTEBOOKS):
-        shutil.copy(path, base / "root" / UNTOUCHED / path.name)
+    (base / "root").mkdir()
     lab_h.write_notebook(base / "root" / LECTURE, LECTURE_CELLS)
     lab_h.write_notebook(base / "root" / REOPENED, REOPENED_CELLS)
     lab_h.write_notebook(base / "root" / TEARDOWN, ["6 * 7"])
@@ -113,29 +103,6 @@ def test_lecture_mode_enlarges_the_notebooks_text_and_off_restores_it(page):
     assert off == before, (before, off)
 
 
-# once JupyterLab has written the kernel's metadata into the model of the notebook `path` (it
-# does so on connecting; an equal value changes nothing): whether the notebook is modified, as
-# its tab shows it, and the metadata of the model and of the kernel
-_CONNECTED_STATE_JS = """async path => {
-    const widget = Array.from(window.jupyterapp.shell.widgets('main')).find(w => w.context?.path === path);
-    const kernel = widget.sessionContext.session.kernel;
-    const [info, spec] = [await kernel.info, await kernel.spec];
-    const canonical = value => JSON.stringify(value, (key, v) => v && typeof v === 'object' && !Array.isArray(v)
-        ? Object.fromEntries(Object.entries(v).sort()) : v);
-    const model = widget.context.model;
-    for (let wait = 0; wait < 100; wait++) {
-        if (canonical(model.getMetadata('language_info')) === canonical(info.language_info)
-                && model.getMetadata('kernelspec')?.display_name === spec.display_name) { break; }
-        await new Promise(resolve => setTimeout(resolve, 100));
-    }
-    const tab = Array.from(document.querySelectorAll('.lm-DockPanel-tabBar .lm-TabBar-tab'))
-        .find(t => t.dataset.id === widget.id);
-    return {dirty: tab.classList.contains('jp-mod-dirty'), modelDirty: model.dirty,
-            kernelspec: model.getMetadata('kernelspec'), language_info: model.getMetadata('language_info'),
-            version: info.language_info.version};
-}"""
-
-
 def _close_active_tab(page) -> str | None:
     """Close the active tab with its close icon, as a reader does; return the title of the
     dialog that appears (after discarding through it), or None."""
@@ -148,35 +115,6 @@ def _close_active_tab(page) -> str | None:
     title = dialog.locator(".jp-Dialog-header").inner_text()
     dialog.locator("button", has_text="Discard").click()
     return title
-
-
-def _changed(stored: dict, shown: dict) -> list[str]:
-    """The metadata fields JupyterLab changed: 'kernelspec.display_name', 'language_info.version', ..."""
-    return sorted(f"{key}.{field}" for key in ("kernelspec", "language_info")
-                  for field in set(stored.get(key, {})) | set(shown.get(key) or {})
-                  if stored.get(key, {}).get(field) != (shown.get(key) or {}).get(field))
-
-
-@pytest.mark.parametrize("name", [p.name for p in chapter_notebooks(NOTEBOOKS)])
-def test_untouched_chapter_opens_unmodified_and_closes_without_asking(name, page):
-    path = f"{UNTOUCHED}/{name}"
-    stored = json.loads((NOTEBOOKS / name).read_text(encoding="utf-8"))["metadata"]
-    lab_h.open_notebook(page, path)
-    state = page.evaluate(_CONNECTED_STATE_JS, path)
-    changed = _changed(stored, state)
-    dialog = _close_active_tab(page)
-    page.wait_for_function("path => !Array.from(window.jupyterapp.shell.widgets('main'))"
-                           ".some(w => w.context?.path === path)", arg=path, timeout=30_000)
-    stored_version = stored.get("language_info", {}).get("version")
-    if stored_version is not None and state["version"] != stored_version:
-        assert changed == ["language_info.version"], (
-            f"{name}: opening it changed {changed}; with a kernel of another Python only the version may differ")
-        pytest.skip(f"the notebooks are stored for Python {stored_version}, the kernel "
-                    f"is Python {state['version']}: JupyterLab marks them modified on opening (it writes "
-                    "the kernel's version into them, jupyter/notebook#2123)")
-    assert not changed, f"{name}: JupyterLab changed the stored metadata {changed} on opening it"
-    assert not state["dirty"] and not state["modelDirty"], f"{name}: marked modified though untouched"
-    assert dialog is None, f"{name}: closing it untouched asked {dialog!r}"
 
 
 # every output the active notebook shows (not hidden): whether it is an explorer's fallback or a
