@@ -424,7 +424,11 @@ def test_chapter_slides_work_offline_with_each_equation_typeset_once(path, cours
     view.page.keyboard.press("Home")
     view.page.wait_for_function("Reveal.isFirstSlide()")
     view.assert_offline_and_clean()
-    assert view.axe(".reveal") == [], "the title slide and reveal.js's controls"
+    # reveal.js's controls, progress bar and live region, which only this view shows. The slides are
+    # checked in the print view (test_every_slide_meets_wcag_aa): here axe cannot measure their
+    # contrast (reveal.js's background layer overlaps every text: "incomplete", not a violation),
+    # and axe over the whole deck took 4 s of a core more
+    assert view.axe(".reveal > :not(.slides)") == [], "reveal.js's controls"
 
 
 @pytest.mark.browser
