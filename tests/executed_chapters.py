@@ -9,8 +9,11 @@ outputs (the session fixture ``executed_chapters`` of tests/conftest.py, an `Exe
   `replay_into`, executing none themselves (a chapter no worker executed yet is executed here
   first: the slides' build once ran the chapters the figure-style test had not reached yet,
   which that test then executed a second time).
-* the student edition: as ``python -m coursekit release`` writes it, executed as it is
-  (tests/test_release.py).
+* the student edition: as ``python -m coursekit release`` writes it (tests/test_release.py). A
+  chapter whose code cells are the instructor edition's, in the same order (no solution is code:
+  the solutions are markdown), runs exactly what the instructor edition runs, so it takes the
+  outputs of the instructor edition's execution (`replay_code`), as the website's build serves
+  both editions from one execution; a chapter with a solution in code is executed as it is.
 
 nbval executes every notebook as its own test besides; the website's build executes its own, since
 it draws every figure for its page's column. Each is executed once per run, in a kernel of this
@@ -27,16 +30,19 @@ from typing import Callable
 
 import nbformat
 
-from coursekit.tools.notebooks import default_notebook_dir, execute_all, read_notebook, write_notebook
+from coursekit.tools.notebooks import ALT, default_notebook_dir, execute_all, read_notebook, write_notebook
 from coursekit.tools.slideshow import DESCRIBE_FIGURES
+from coursekit.tools.static_explorers import MIME as FRAMES
 from kernels import this_python_kernel
 from notebook_figures import PRELUDE as FIGURE_CHECKS, REPORT
 from run_once import once, shared_folder
 
-__all__ = ["PRELUDE", "Executed", "ExecutedChapters", "replay_into", "replaying"]
+__all__ = ["PRELUDE", "Executed", "ExecutedChapters", "replay_into", "replay_code", "replaying"]
 
 #: the first cell of the instructor edition: the slides' figure descriptions, the figure checks
 PRELUDE = DESCRIBE_FIGURES + FIGURE_CHECKS
+#: what `PRELUDE` adds to the outputs (descriptions, explorers' frames, figure checks' reports)
+PRELUDE_MEDIA = (ALT, FRAMES, REPORT)
 
 @dataclass
 class Executed:
@@ -63,8 +69,9 @@ class ExecutedChapters:
         return self._read[key]
 
     def student(self) -> Executed:
+        """The student edition, built and executed (see the module's doc)."""
         if ("student", "") not in self._read:
-            folder = once(self._folder / "student", _execute_student)
+            folder = once(self._folder / "student", lambda out: _execute_student(out, self.instructor))
             paths = sorted((folder / "edition").glob("*.ipynb"))
             executed = [read_notebook(folder / "executed" / path.name) for path in paths]
             self._read[("student", "")] = Executed(paths, executed)
@@ -83,13 +90,22 @@ def _execute_instructor(name: str, out: Path) -> None:
     write_notebook(nb, out / name)
 
 
-def _execute_student(folder: Path) -> None:
-    """The student edition as ``python -m coursekit release`` writes it into ``folder/edition``,
-    executed there; the executed copies written into ``folder/executed``."""
+def _execute_student(folder: Path, instructor: Callable) -> None:
+    """The student edition as ``python -m coursekit release`` writes it into ``folder/edition``, each
+    chapter given the outputs of `instructor` (its name -> the instructor edition executed) where
+    their code is the same, else executed there; the executed copies written into ``folder/executed``."""
     from coursekit.tools.release import build_release
     paths = build_release(folder / "edition")
     notebooks = [read_notebook(path) for path in paths]
-    _execute(notebooks, paths)
+    own = []
+    for nb, path in zip(notebooks, paths):
+        shared = instructor(path.name)
+        if _code(nb) == _code(shared)[1:]:       # after the prelude
+            replay_code(nb, shared)
+        else:
+            own.append((nb, path))
+    if own:
+        _execute(*map(list, zip(*own)))
     (folder / "executed").mkdir()
     for nb, path in zip(notebooks, paths):
         write_notebook(nb, folder / "executed" / path.name)
@@ -115,6 +131,27 @@ def replay_into(nb, executed, *, drop: tuple[str, ...] = ()) -> None:
             for output in cell.outputs:
                 for media in drop:
                     output.get("data", {}).pop(media, None)
+    nb.metadata["language_info"] = copy.deepcopy(executed.metadata.get("language_info", {}))
+
+
+def _code(nb) -> list[str]:
+    return [c.source for c in nb.cells if c.cell_type == "code"]
+
+
+def replay_code(nb, executed) -> None:
+    """Give the code cells of `nb` (a notebook whose code cells are those of `executed` after its
+    prelude cell) the outputs and execution counts they had in `executed`, in place, as a run
+    without the prelude gives them: without what it adds (`PRELUDE_MEDIA`), counted from 1."""
+    ran = [c for c in executed.cells[1:] if c.cell_type == "code"]
+    cells = [c for c in nb.cells if c.cell_type == "code"]
+    assert [c.source for c in cells] == [c.source for c in ran], "the code differs from the shared copy's"
+    for cell, done in zip(cells, ran):
+        cell.outputs = copy.deepcopy(done.outputs)
+        cell.execution_count = None if done.execution_count is None else done.execution_count - 1
+        for output in cell.outputs:
+            for media in PRELUDE_MEDIA:
+                output.get("data", {}).pop(media, None)
+                output.get("metadata", {}).pop(media, None)
     nb.metadata["language_info"] = copy.deepcopy(executed.metadata.get("language_info", {}))
 
 

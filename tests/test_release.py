@@ -1,8 +1,10 @@
 """The student edition: built from the real notebooks, executed, and checked cell by cell.
 
 The release of the four notebooks is built once into a temporary folder and executed once per
-test session (the session fixture ``executed_chapters``, tests/executed_chapters.py); the tests
-below then read the built files and the executed notebooks. The unit tests at the end use small
+test session (the session fixture ``executed_chapters``, tests/executed_chapters.py: a chapter
+whose code cells are the instructor edition's, as the test below on solution cells asserts, takes
+the outputs of the instructor edition's execution, which runs the same code); the tests below then
+read the built files and the executed notebooks. The unit tests at the end use small
 notebooks made here, with both kinds of solution cell (markdown ``<details>`` and code).
 """
 
