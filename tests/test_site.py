@@ -226,24 +226,42 @@ def _counted(name: str) -> list:
             _code(f"_ = open('runs-{name}.log', 'a').write('run\\n')")]
 
 
+#: run in the tiny chapter's kernel: a connection to a host of the documentation range (RFC 5737)
+_PROBE = ("import socket\ntry:\n    socket.create_connection(('192.0.2.1', 80), 1)\n"
+          "except OSError as e:\n    print('refused:', e)")
+
+
 @pytest.fixture(scope="module")
 def small_site(tmp_path_factory):
-    """The small chapter (and a tiny one with no solution in code) built in both editions by one
-    call: ``({False: (index, page), True: (index, page)}, {chapter: times executed})``."""
+    """The small chapter (and a tiny one with no solution in code, whose last cell tries to reach
+    the network) built in both editions by one ``python -m coursekit site`` with every outside
+    connection refused and logged (`_NO_NETWORK`): ``({False: (index, page), True: (index, page)},
+    {chapter: times executed}, [the connections refused])``."""
     missing = site.missing_site_tools()
     if missing:
         pytest.skip("the site extra is not installed (missing: " + ", ".join(missing) + ")")
     root = tmp_path_factory.mktemp("small")
-    folder = root / "nb"
+    folder, guard = root / "nb", root / "guard"
     folder.mkdir()
-    for name, cells in [("07_small", SMALL_NOTEBOOK + _counted("07")[1:]), ("08_tiny", _counted("08"))]:
+    guard.mkdir()
+    (guard / "sitecustomize.py").write_text(_NO_NETWORK, encoding="utf-8")
+    tiny = _counted("08") + [_code(_PROBE)]
+    for name, cells in [("07_small", SMALL_NOTEBOOK + _counted("07")[1:]), ("08_tiny", tiny)]:
         nb = nbformat.v4.new_notebook(cells=cells)
         nb.metadata["kernelspec"] = kernelspec_metadata()
         nbformat.write(nb, folder / f"{name}.ipynb")
-    index = site.build_site(root / "site", student_out=root / "student", notebooks_dir=folder)
-    editions = {False: index, True: root / "student" / "index.html"}
+    log = root / "network.log"
+    log.touch()
+    package = str(Path(site.__file__).resolve().parents[2])
+    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(guard), package]), CK_NETWORK_LOG=str(log))
+    result = subprocess.run([sys.executable, "-m", "coursekit", "site", "--out", str(root / "site"), "--student-out",
+                             str(root / "student"), "--notebooks", str(folder)],
+                            env=env, capture_output=True, text=True, timeout=600)
+    assert result.returncode == 0, result.stderr[-3000:]
+    editions = {False: root / "site" / "index.html", True: root / "student" / "index.html"}
     runs = {name: (folder / f"runs-{name}.log").read_text().count("run") for name in ("07", "08")}
-    return {student: (i, (i.parent / "07_small.html").read_text(encoding="utf-8")) for student, i in editions.items()}, runs
+    pages = {student: (i, (i.parent / "07_small.html").read_text(encoding="utf-8")) for student, i in editions.items()}
+    return pages, runs, log.read_text().splitlines()
 
 
 def test_small_build_both_editions_from_one_execution_unless_a_solution_is_code(small_site):
@@ -341,24 +359,6 @@ socket.socket.connect = _refuse_outside
 """
 
 
-def test_the_site_builds_with_every_outside_connection_refused(tmp_path):
-    if site.missing_site_tools():
-        pytest.skip("the site extra is not installed")
-    guard = tmp_path / "guard"
-    guard.mkdir()
-    (guard / "sitecustomize.py").write_text(_NO_NETWORK, encoding="utf-8")
-    folder = tmp_path / "nb"
-    folder.mkdir()
-    nb = nbformat.v4.new_notebook()
-    nb.metadata["kernelspec"] = kernelspec_metadata()
-    nb.cells = SMALL_NOTEBOOK + [_code("import socket\ntry:\n    socket.create_connection(('192.0.2.1', 80), 1)\n"
-                                       "except OSError as e:\n    print('refused:', e)")]
-    nbformat.write(nb, folder / "07_small.ipynb")
-    log = tmp_path / "network.log"
-    root = str(Path(site.__file__).resolve().parents[2])
-    env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(guard), root]), CK_NETWORK_LOG=str(log))
-    result = subprocess.run([sys.executable, "-m", "coursekit", "site", "--out", str(tmp_path / "out"),
-                             "--notebooks", str(folder)], env=env, capture_output=True, text=True, timeout=600)
-    assert result.returncode == 0, result.stderr[-3000:]
+def test_the_site_builds_with_every_outside_connection_refused(small_site):
     # the probe cell's own attempt is the only one: the guard works, and the build asked for nothing
-    assert log.read_text().splitlines() == ["('192.0.2.1', 80)"]
+    assert small_site[2] == ["('192.0.2.1', 80)"]
