@@ -251,4 +251,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
+    from .tools.notebooks import leave_out_the_iri_grammar
+    leave_out_the_iri_grammar()      # this process is the tools' own: a second of a core less
     sys.exit(main())

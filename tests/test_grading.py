@@ -260,7 +260,7 @@ def test_the_runner_refuses_only_the_iri_grammar_and_still_validates_notebooks()
     of the runner's process; nbformat and nbclient work as before."""
     if importlib.util.find_spec("rfc3987_syntax") is None:
         pytest.skip("rfc3987-syntax is not installed here: there is no grammar to leave out")
-    code = ("import sys\nfrom coursekit.tools.grading.runner import leave_out_the_iri_grammar\n"
+    code = ("import sys\nfrom coursekit.tools.notebooks import leave_out_the_iri_grammar\n"
             "leave_out_the_iri_grammar()\nimport jsonschema, nbclient, nbformat\n"
             "nbformat.validate(nbformat.v4.new_notebook(cells=[nbformat.v4.new_code_cell('1 + 1')]))\n"
             "print(sys.modules['rfc3987_syntax'], 'iri' in jsonschema.FormatChecker.checkers,\n"

@@ -9,7 +9,9 @@ metadata (`slides`, `kernel_metadata`, `colab`) and the grader read their notebo
   rewrites those a change would alter;
 * `execute_all` executes them side by side (nbclient, one kernel per core at a time, without
   storing widget state: explorers keep their figure);
-* `harvest_alt_texts` gives each figure of an executed notebook its text alternative.
+* `harvest_alt_texts` gives each figure of an executed notebook its text alternative;
+* `leave_out_the_iri_grammar` spares a process of the tools (the command line, the grader's
+  runner, the site's Sphinx build) a second of a core that importing nbformat would cost it.
 
 nbformat and nbclient (installed with JupyterLab) are imported inside the functions, so
 ``import coursekit`` does not need them.
@@ -24,7 +26,8 @@ from pathlib import Path
 from typing import Callable
 
 __all__ = ["WIDGET_VIEW", "ALT", "default_notebook_dir", "notebook_paths", "chapter_notebooks",
-           "read_notebook", "write_notebook", "update_notebooks", "execute_all", "harvest_alt_texts", "text_of", "say"]
+           "read_notebook", "write_notebook", "update_notebooks", "execute_all", "harvest_alt_texts", "text_of", "say",
+           "leave_out_the_iri_grammar"]
 
 #: the media type of a widget's view in an output (an explorer's live view)
 WIDGET_VIEW = "application/vnd.jupyter.widget-view+json"
@@ -39,6 +42,20 @@ def _nbformat():
         raise ImportError("reading notebooks needs nbformat, which comes with JupyterLab: "
                           'python -m pip install -e ".[lab]"') from error
     return nbformat
+
+
+def leave_out_the_iri_grammar() -> None:
+    """Keep this process from building the IRI grammar of the package rfc3987-syntax: nbformat imports
+    jsonschema, which imports that package when it is installed (JupyterLab brings it) for its
+    ``iri`` format, and the package builds its grammar on import, about 0.8 s of a core of the 1 s
+    that importing nbformat costs (60 % of a grader runner's work on a short notebook;
+    python-jsonschema/jsonschema#1428). Nothing here checks that format: nbformat's schemas use
+    none and nbformat validates with fastjsonschema. Without the package, jsonschema leaves the
+    ``iri`` format out, as it is documented to; the import is refused the way Python documents (a
+    ``None`` in ``sys.modules``) and only in this process. Called where a process of the tools
+    starts (``python -m coursekit``, the grader's runner, the site's Sphinx build), not by a library call
+    into a process of the user's."""
+    sys.modules.setdefault("rfc3987_syntax", None)
 
 
 def default_notebook_dir() -> Path:

@@ -455,9 +455,15 @@ def github_repository(repository: str | None) -> str | None:
     return f"https://github.com/{match.group(1)}" if match else None
 
 
+#: sphinx-build (its own entry, ``sphinx.cmd.build.main``, as ``python -m sphinx`` runs it) in a
+#: process spared the IRI grammar that MyST-NB's import of nbformat would build
+#: (`coursekit.tools.notebooks.leave_out_the_iri_grammar`)
+_SPHINX_BUILD = [sys.executable, "-c", "import sys; from coursekit.tools.notebooks import leave_out_the_iri_grammar; "
+                 "leave_out_the_iri_grammar(); from sphinx.cmd.build import main; sys.exit(main(sys.argv[1:]))"]
+
+
 def _run_sphinx(src: Path, html: Path) -> None:
-    cmd = [sys.executable, "-m", "sphinx", "-b", "html", "-q", "-j", "auto", str(src), str(html),
-           "-d", str(src.parent / "doctrees")]
+    cmd = [*_SPHINX_BUILD, "-b", "html", "-q", "-j", "auto", str(src), str(html), "-d", str(src.parent / "doctrees")]
     result = subprocess.run(cmd, capture_output=True, text=True, env=dict(os.environ, PYTHONWARNINGS="ignore"))
     if result.returncode != 0:
         raise RuntimeError(f"Sphinx failed to build the site (exit {result.returncode}):\n"

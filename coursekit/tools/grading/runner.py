@@ -34,11 +34,10 @@ import threading
 import time
 from pathlib import Path
 
-from ..notebooks import read_notebook
+from ..notebooks import leave_out_the_iri_grammar, read_notebook
 from .kernel import set_limits
 
-__all__ = ["KERNEL_NAME", "RUNNER_MEMORY", "STARTS", "RUNNER_STATUSES", "write_kernel_spec", "execute",
-           "leave_out_the_iri_grammar", "main"]
+__all__ = ["KERNEL_NAME", "RUNNER_MEMORY", "STARTS", "RUNNER_STATUSES", "write_kernel_spec", "execute", "main"]
 
 #: name of the kernel spec the grader writes for its kernels
 KERNEL_NAME = "coursekit-grade"
@@ -165,17 +164,6 @@ def _end_with(parent: int) -> None:
     while os.getppid() == parent:
         time.sleep(1)
     os._exit(3)
-
-
-def leave_out_the_iri_grammar() -> None:
-    """Keep this process from building the IRI grammar of the package rfc3987-syntax: nbformat imports
-    jsonschema, which imports that package when it is installed (JupyterLab brings it) for its
-    ``iri`` format, and the package builds its grammar on import, about 1 s of a core: 60 % of a
-    runner's work on a short notebook (python-jsonschema/jsonschema#1428). Nothing here checks that
-    format: nbformat's schemas use none and nbformat validates with fastjsonschema. Without the
-    package, jsonschema leaves the ``iri`` format out, as it is documented to; the import is refused
-    the way Python documents (a ``None`` in ``sys.modules``) and only in this process."""
-    sys.modules.setdefault("rfc3987_syntax", None)
 
 
 def main(argv: list[str]) -> int:
