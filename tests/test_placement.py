@@ -37,12 +37,7 @@ def test_single_input_matches_python_control_with_flipped_sign(n, seed):
     # 1e-14 (checked against a 60-digit oracle), so check the characteristic polynomial instead
     p = ck.poly_from_roots(poles)
     np.testing.assert_allclose(ck.charpoly(A + B @ K), p, rtol=1e-6, atol=1e-6 * np.abs(p).max())
-    # the eigenvalues to what rounding leaves of them (Bauer-Fike: the condition number of the
-    # eigenvectors times the rounding of A + B K; up to 2e10 in these draws, where the exact K
-    # rounded to floats moves them by 2e-3), at 1e-6 at least
-    eigenvalues, vectors = np.linalg.eig(A + B @ K)
-    rounding = np.linalg.cond(vectors) * 10 * np.finfo(float).eps * (np.linalg.norm(A, 2) + np.linalg.norm(B @ K, 2))
-    np.testing.assert_allclose(sorted_eig(eigenvalues), sorted_eig(poles), atol=max(1e-6, rounding))
+    _assert_poles_to_rounding(A, B, K, poles)
     K_ref = -np.atleast_2d(control.acker(A, B, poles))
     np.testing.assert_allclose(K, K_ref, rtol=1e-6, atol=1e-8 * np.abs(K_ref).max())
 
@@ -96,6 +91,16 @@ def _random_pair(n, m, seed, max_cond):
     return None if np.linalg.cond(ck.ctrb(A, B)) > max_cond else (A, B)
 
 
+def _assert_poles_to_rounding(A, B, K, poles):
+    """eig(A + B K) are `poles` to what rounding leaves of them (Bauer-Fike: the condition number of
+    the eigenvectors times the rounding of A + B K; up to 2e10 in the draws of the flipped-sign test,
+    where the exact K rounded to floats moves them by 2e-3, and 5e6 for n = 3, seed = 5236 of the
+    oracle's, by 9e-5), at 1e-6 at least."""
+    eigenvalues, vectors = np.linalg.eig(A + B @ K)
+    rounding = np.linalg.cond(vectors) * 10 * np.finfo(float).eps * (np.linalg.norm(A, 2) + np.linalg.norm(B @ K, 2))
+    np.testing.assert_allclose(sorted_eig(eigenvalues), sorted_eig(poles), atol=max(1e-6, rounding))
+
+
 def _high_precision_gain(A, B, poles, digits=40):
     """Independent oracle: Ackermann's formula K = -e_n^T Wc^-1 p(A) in 40-digit arithmetic."""
     import mpmath as mp
@@ -119,6 +124,7 @@ def _high_precision_gain(A, B, poles, digits=40):
 
 
 @given(st.integers(2, 10), st.integers(0, 10_000))
+@example(3, 5236)     # found in CI: K within 5e-12 of the oracle's, its poles 3e-4 off (condition 5e6)
 def test_single_input_up_to_n_10_agrees_with_a_high_precision_oracle_to_1e_6(n, seed):
     # the issue's accuracy requirement: random systems, n <= 10, well-separated poles
     pair = _random_pair(n, 1, seed, max_cond=1e8)
@@ -129,8 +135,8 @@ def test_single_input_up_to_n_10_agrees_with_a_high_precision_oracle_to_1e_6(n, 
     K, _ = checked(ck.place, A, B, poles)     # warns where even the exact K misses by > 1e-6
     K_ref = _high_precision_gain(A, B, poles)
     np.testing.assert_allclose(K, K_ref, rtol=1e-6, atol=1e-6 * np.abs(K_ref).max())
-    if n <= 4:   # small n: the closed-loop eigenvalues themselves are well conditioned
-        np.testing.assert_allclose(sorted_eig(np.linalg.eigvals(A + B @ K)), sorted_eig(poles), atol=1e-6)
+    if n <= 4:   # small n: the closed-loop eigenvalues are mostly well conditioned
+        _assert_poles_to_rounding(A, B, K, poles)
 
 
 @given(st.integers(2, 5), st.integers(0, 10_000), st.floats(-4, -0.5))
