@@ -15,12 +15,6 @@ import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 from hypothesis import HealthCheck, settings  # noqa: E402
 
-from coursekit.tools.notebooks import leave_out_the_iri_grammar  # noqa: E402
-
-# the run's own processes (the workers, the test sessions started by tests) import nbformat
-# without building the IRI grammar nothing here checks (about 0.8 s of a core each)
-leave_out_the_iri_grammar()
-
 # pytester: tests/test_suite_plugin.py runs small test sessions of its own
 pytest_plugins = ["pytester", "suite_plugin"]
 
