@@ -124,14 +124,8 @@ def replay_into(nb, executed, *, drop: tuple[str, ...] = ()) -> None:
     assert nb.cells[0].source in executed.cells[0].source, "the prelude differs from the shared copy's"
     assert [(c.cell_type, c.source) for c in nb.cells[1:]] == \
         [(c.cell_type, c.source) for c in executed.cells[1:]], "the cells differ from the shared copy's"
-    for cell, ran in zip(nb.cells, executed.cells):
-        if cell.cell_type == "code":
-            cell.outputs = copy.deepcopy(ran.outputs)
-            cell.execution_count = ran.execution_count
-            for output in cell.outputs:
-                for media in drop:
-                    output.get("data", {}).pop(media, None)
-    nb.metadata["language_info"] = copy.deepcopy(executed.metadata.get("language_info", {}))
+    _give_outputs(nb, executed, [(c, ran) for c, ran in zip(nb.cells, executed.cells) if c.cell_type == "code"],
+                  drop=drop, counted_from=1)
 
 
 def _code(nb) -> list[str]:
@@ -145,11 +139,19 @@ def replay_code(nb, executed) -> None:
     ran = [c for c in executed.cells[1:] if c.cell_type == "code"]
     cells = [c for c in nb.cells if c.cell_type == "code"]
     assert [c.source for c in cells] == [c.source for c in ran], "the code differs from the shared copy's"
-    for cell, done in zip(cells, ran):
-        cell.outputs = copy.deepcopy(done.outputs)
-        cell.execution_count = None if done.execution_count is None else done.execution_count - 1
+    _give_outputs(nb, executed, list(zip(cells, ran)), drop=PRELUDE_MEDIA, counted_from=2)
+
+
+def _give_outputs(nb, executed, pairs: list, *, drop: tuple[str, ...], counted_from: int) -> None:
+    """Each (cell of `nb`, cell of `executed`) of `pairs`: the first gets the second's outputs without
+    the media types `drop`, and its execution count renumbered from 1 where `executed` counted from
+    `counted_from`; `nb` gets the language of `executed`."""
+    for cell, ran in pairs:
+        cell.outputs = copy.deepcopy(ran.outputs)
+        count = ran.execution_count
+        cell.execution_count = None if count is None else count - (counted_from - 1)
         for output in cell.outputs:
-            for media in PRELUDE_MEDIA:
+            for media in drop:
                 output.get("data", {}).pop(media, None)
                 output.get("metadata", {}).pop(media, None)
     nb.metadata["language_info"] = copy.deepcopy(executed.metadata.get("language_info", {}))
